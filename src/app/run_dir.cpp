@@ -1,0 +1,42 @@
+#include "app/run_dir.h"
+
+#include <fstream>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+
+namespace kf {
+namespace fs = std::filesystem;
+
+fs::path run_dir_for(const Scene& scene, const std::string& out_option) {
+  if (!out_option.empty()) return fs::path(out_option);
+  return fs::path("out") / scene.name;
+}
+
+void prepare_run_dir(const fs::path& dir, const Scene& scene) {
+  ensure_directory(dir);
+  std::ifstream in(scene.file, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  // Keep the scene's name: the copy is read back with the run directory's scene name.
+  auto j = nlohmann::json::parse(os.str());
+  write_file_atomic(dir / "scene.json", j.dump(2) + "\n");
+  write_file_atomic(dir / "scene_name.txt", scene.name + "\n" + fs::absolute(scene.directory).string() + "\n");
+}
+
+Scene load_run_scene(const fs::path& dir) {
+  if (!fs::is_directory(dir)) throw InputError(dir.string() + ": not a run directory (does not exist)");
+  const fs::path file = dir / "scene.json";
+  if (!fs::exists(file)) throw InputError(dir.string() + ": not a run directory (no scene.json)");
+  Scene s = load_scene(file);
+  std::ifstream names(dir / "scene_name.txt");
+  std::string name, scene_dir;
+  if (std::getline(names, name) && !name.empty()) s.name = name;
+  if (std::getline(names, scene_dir) && !scene_dir.empty()) s.directory = scene_dir;
+  return s;
+}
+
+void write_json(const fs::path& path, const nlohmann::json& j) { write_file_atomic(path, j.dump(2) + "\n"); }
+
+}  // namespace kf

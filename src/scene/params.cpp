@@ -1,0 +1,219 @@
+#include "scene/params.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace kf {
+
+std::string pointer_escape(const std::string& key) {
+  std::string out;
+  for (char c : key) {
+    if (c == '~') out += "~0";
+    else if (c == '/') out += "~1";
+    else out += c;
+  }
+  return out;
+}
+
+Block::Block(const Json& j, std::string file, std::string pointer)
+    : j_(j), file_(std::move(file)), pointer_(std::move(pointer)) {
+  if (!j_.is_object()) fail_here("expected an object, got " + describe(j_));
+}
+
+std::string Block::pointer(const std::string& key) const { return pointer_ + "/" + pointer_escape(key); }
+
+void Block::fail(const std::string& key, const std::string& expected) const {
+  throw InputError(file_ + ": " + pointer(key) + ": " + expected);
+}
+
+void Block::fail_here(const std::string& expected) const {
+  throw InputError(file_ + ": " + (pointer_.empty() ? std::string("/") : pointer_) + ": " + expected);
+}
+
+std::string Block::describe(const Json& v) {
+  std::string s = v.dump();
+  if (s.size() > 40) s = s.substr(0, 37) + "...";
+  const char* type = v.type_name();
+  return std::string(type) + " " + s;
+}
+
+bool Block::has(const std::string& key) const { return j_.contains(key); }
+
+const Json* Block::find(const std::string& key) {
+  read_.insert(key);
+  auto it = j_.find(key);
+  return it == j_.end() ? nullptr : &*it;
+}
+
+const Json& Block::required(const std::string& key) {
+  const Json* v = find(key);
+  if (!v) fail(key, "required key is missing");
+  return *v;
+}
+
+double Block::as_number(const Json& v, const std::string& key, double lo, double hi) const {
+  if (!v.is_number()) fail(key, "expected a number, got " + describe(v));
+  double d = v.get<double>();
+  if (!std::isfinite(d)) fail(key, "expected a finite number");
+  if (d < lo || d > hi) {
+    std::ostringstream os;
+    os << "expected a number in [" << lo << ", " << hi << "], got " << d;
+    fail(key, os.str());
+  }
+  return d;
+}
+
+double Block::number(const std::string& key, double def, double lo, double hi) {
+  const Json* v = find(key);
+  return v ? as_number(*v, key, lo, hi) : def;
+}
+
+double Block::number(const std::string& key, double lo, double hi) { return as_number(required(key), key, lo, hi); }
+
+static int to_int(const Block& b, const Json& v, const std::string& key, int lo, int hi) {
+  if (!v.is_number_integer() && !(v.is_number_float() && std::floor(v.get<double>()) == v.get<double>() &&
+                                   std::isfinite(v.get<double>())))
+    b.fail(key, "expected an integer, got " + std::string(v.type_name()) + " " + v.dump());
+  double d = v.get<double>();
+  if (d < lo || d > hi)
+    b.fail(key, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + v.dump());
+  return int(d);
+}
+
+int Block::integer(const std::string& key, int def, int lo, int hi) {
+  const Json* v = find(key);
+  return v ? to_int(*this, *v, key, lo, hi) : def;
+}
+
+int Block::integer(const std::string& key, int lo, int hi) { return to_int(*this, required(key), key, lo, hi); }
+
+bool Block::boolean(const std::string& key, bool def) {
+  const Json* v = find(key);
+  if (!v) return def;
+  if (!v->is_boolean()) fail(key, "expected true or false, got " + describe(*v));
+  return v->get<bool>();
+}
+
+static std::string check_choice(const Block& b, const std::string& key, const std::string& s,
+                                const std::vector<std::string>& choices) {
+  if (choices.empty()) return s;
+  for (const auto& c : choices)
+    if (c == s) return s;
+  std::string list;
+  for (const auto& c : choices) list += (list.empty() ? "" : ", ") + ("\"" + c + "\"");
+  b.fail(key, "expected one of " + list + ", got \"" + s + "\"");
+}
+
+std::string Block::string(const std::string& key, const std::string& def, const std::vector<std::string>& choices) {
+  const Json* v = find(key);
+  if (!v) return def;
+  if (!v->is_string()) fail(key, "expected a string, got " + describe(*v));
+  return check_choice(*this, key, v->get<std::string>(), choices);
+}
+
+std::string Block::string(const std::string& key, const std::vector<std::string>& choices) {
+  const Json& v = required(key);
+  if (!v.is_string()) fail(key, "expected a string, got " + describe(v));
+  return check_choice(*this, key, v.get<std::string>(), choices);
+}
+
+std::vector<double> Block::numbers(const std::string& key, int min_count, double lo, double hi) {
+  const Json& v = required(key);
+  if (!v.is_array() || int(v.size()) < min_count)
+    fail(key, "expected an array of at least " + std::to_string(min_count) + " numbers, got " + describe(v));
+  std::vector<double> out;
+  for (size_t i = 0; i < v.size(); ++i) out.push_back(as_number(v[i], key + "/" + std::to_string(i), lo, hi));
+  return out;
+}
+
+std::vector<int> Block::integers(const std::string& key, int min_count, int lo, int hi) {
+  const Json& v = required(key);
+  if (!v.is_array() || int(v.size()) < min_count)
+    fail(key, "expected an array of at least " + std::to_string(min_count) + " integers, got " + describe(v));
+  std::vector<int> out;
+  for (size_t i = 0; i < v.size(); ++i) out.push_back(to_int(*this, v[i], key + "/" + std::to_string(i), lo, hi));
+  return out;
+}
+
+static Vec3 to_vec3(const Block& b, const Json& v, const std::string& key, double lo, double hi) {
+  if (!v.is_array() || v.size() != 3) b.fail(key, "expected [x, y, z], got " + std::string(v.type_name()) + " " + v.dump());
+  Vec3 out;
+  for (int i = 0; i < 3; ++i) {
+    if (!v[i].is_number() || !std::isfinite(v[i].get<double>()) || v[i].get<double>() < lo || v[i].get<double>() > hi)
+      b.fail(key + "/" + std::to_string(i), "expected a finite number in [" + std::to_string(lo) + ", " +
+                                                 std::to_string(hi) + "], got " + v[i].dump());
+    out[i] = v[i].get<double>();
+  }
+  return out;
+}
+
+Vec3 Block::vec3(const std::string& key, const Vec3& def, double lo, double hi) {
+  const Json* v = find(key);
+  return v ? to_vec3(*this, *v, key, lo, hi) : def;
+}
+
+Vec3 Block::vec3(const std::string& key, double lo, double hi) { return to_vec3(*this, required(key), key, lo, hi); }
+
+std::vector<Vec2> Block::points2(const std::string& key, int min_count, double lo, double hi) {
+  const Json& v = required(key);
+  if (!v.is_array() || int(v.size()) < min_count)
+    fail(key, "expected a list of at least " + std::to_string(min_count) + " [a, b] points, got " + describe(v));
+  std::vector<Vec2> out;
+  for (size_t i = 0; i < v.size(); ++i) {
+    const Json& p = v[i];
+    const std::string k = key + "/" + std::to_string(i);
+    if (!p.is_array() || p.size() != 2) fail(k, "expected [a, b], got " + describe(p));
+    Vec2 q(as_number(p[0], k + "/0", lo, hi), as_number(p[1], k + "/1", lo, hi));
+    out.push_back(q);
+  }
+  return out;
+}
+
+std::vector<Vec3> Block::points3(const std::string& key, int min_count, double lo, double hi) {
+  const Json& v = required(key);
+  if (!v.is_array() || int(v.size()) < min_count)
+    fail(key, "expected a list of at least " + std::to_string(min_count) + " [x, y, z] points, got " + describe(v));
+  std::vector<Vec3> out;
+  for (size_t i = 0; i < v.size(); ++i) out.push_back(to_vec3(*this, v[i], key + "/" + std::to_string(i), lo, hi));
+  return out;
+}
+
+Block Block::child(const std::string& key) {
+  const Json* v = find(key);
+  if (!v) return Block(Json::object(), file_, pointer(key));
+  if (!v->is_object()) fail(key, "expected an object, got " + describe(*v));
+  return Block(*v, file_, pointer(key));
+}
+
+std::optional<Block> Block::optional_child(const std::string& key) {
+  if (!has(key)) {
+    read_.insert(key);
+    return std::nullopt;
+  }
+  return child(key);
+}
+
+std::vector<Block> Block::array(const std::string& key, int min_count) {
+  const Json* v = find(key);
+  if (!v) {
+    if (min_count > 0) fail(key, "required key is missing");
+    return {};
+  }
+  if (!v->is_array() || int(v->size()) < min_count)
+    fail(key, "expected an array of at least " + std::to_string(min_count) + " objects, got " + describe(*v));
+  std::vector<Block> out;
+  for (size_t i = 0; i < v->size(); ++i) {
+    if (!(*v)[i].is_object()) fail(key + "/" + std::to_string(i), "expected an object, got " + describe((*v)[i]));
+    out.emplace_back((*v)[i], file_, pointer(key) + "/" + std::to_string(i));
+  }
+  return out;
+}
+
+void Block::finish() const {
+  for (auto it = j_.begin(); it != j_.end(); ++it)
+    if (!read_.count(it.key())) fail(it.key(), "unknown key (check its spelling; see README 'Scene files')");
+}
+
+}  // namespace kf

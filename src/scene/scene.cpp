@@ -1,0 +1,128 @@
+#include "scene/scene.h"
+
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+#include "scene/params.h"
+
+namespace kf {
+
+int Scene::particles() const {
+  if (flock) return flock->agents;
+  if (cloth) return cloth->nx * cloth->ny;
+  return 0;
+}
+
+namespace {
+
+TimeSpec parse_time(Block b) {
+  TimeSpec t;
+  t.fps = b.number("fps", t.fps, 1, 10000);
+  t.substeps = b.integer("substeps", t.substeps, 1, 10000);
+  t.frames = b.integer("frames", t.frames, 1, 1'000'000);
+  b.finish();
+  if (t.steps() > 10'000'000) b.fail_here("too many steps (frames x substeps must be at most 1e7)");
+  return t;
+}
+
+ObjectiveSpec parse_objective(Block b, const Scene& s) {
+  ObjectiveSpec o;
+  const bool flock = s.flock.has_value();
+  o.type = b.string("type", {"position", "velocity", "center_of_mass", "shape", "arch"});
+  o.frame = b.integer("frame", 0, s.time.frames);
+  o.weight = b.number("weight", 1.0, 0.0, 1e12);
+  const int p = s.particles();
+  if (b.has("particles")) {
+    o.particles = b.integers("particles", 1, 0, p - 1);
+  }
+  if (o.type == "position" || o.type == "velocity") {
+    o.targets = b.points3("targets", 1);
+    const size_t n = o.particles.empty() ? size_t(p) : o.particles.size();
+    if (o.targets.size() != 1 && o.targets.size() != n)
+      b.fail("targets", "expected 1 target or one per particle (" + std::to_string(n) + "), got " +
+                            std::to_string(o.targets.size()));
+  } else if (o.type == "center_of_mass") {
+    o.targets = {b.vec3("target")};
+  } else if (o.type == "shape") {
+    if (!flock) b.fail("type", "\"shape\" keyframes are for flocks; use \"position\" or \"arch\" for cloth");
+    o.polygon = b.points2("polygon", 3);
+  } else if (o.type == "arch") {
+    if (flock) b.fail("type", "\"arch\" keyframes are for cloth");
+    o.axis_point = b.vec3("axis_point");
+    o.axis = b.vec3("axis", Vec3::UnitZ(), -1e3, 1e3);
+    if (o.axis.norm() < 1e-9) b.fail("axis", "expected a non-zero direction");
+    o.axis.normalize();
+    o.radius = b.number("radius", 1e-4, 1e4);
+  }
+  b.finish();
+  return o;
+}
+
+ControlSpec parse_controls(Block b, const Scene& s) {
+  ControlSpec c;
+  c.kind = b.string("kind", c.kind, {"per_step", "per_frame", "initial_velocity"});
+  c.alpha = b.number("alpha", c.alpha, 0.0, 1e6);
+  b.finish();
+  return c;
+}
+
+OptimizerSpec parse_optimizer(Block b) {
+  OptimizerSpec o;
+  o.max_iterations = b.integer("max_iterations", o.max_iterations, 0, 100000);
+  o.ftol_rel = b.number("ftol_rel", o.ftol_rel, 0.0, 1.0);
+  o.max_seconds = b.number("max_seconds", o.max_seconds, 0.0, 1e7);
+  o.memory = b.integer("memory", o.memory, 1, 100);
+  b.finish();
+  return o;
+}
+
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::filesystem::path& file) {
+  Json j;
+  try {
+    j = Json::parse(text);
+  } catch (const Json::parse_error& e) {
+    // nlohmann's message already carries the byte position.
+    std::string what = e.what();
+    auto pos = what.find("parse error");
+    throw InputError(file.string() + ": not valid JSON: " + (pos == std::string::npos ? what : what.substr(pos)));
+  }
+  Scene s;
+  s.file = file;
+  s.name = file.stem().string();
+  s.directory = file.parent_path();
+  Block root(j, file.string());
+  s.seed = unsigned(root.integer("seed", 1, 0, 2'000'000'000));
+  s.time = parse_time(root.child("time"));
+  const bool has_flock = root.has("flock"), has_cloth = root.has("cloth");
+  if (has_flock == has_cloth) root.fail_here("expected exactly one of \"flock\" or \"cloth\"");
+  if (has_flock) {
+    Block b = root.child("flock");
+    s.flock = parse_flock_spec(b);
+  } else {
+    Block b = root.child("cloth");
+    s.cloth = parse_cloth_spec(b);
+  }
+  for (Block& b : root.array("objectives")) s.objectives.push_back(parse_objective(std::move(b), s));
+  s.controls = parse_controls(root.child("controls"), s);
+  s.optimizer = parse_optimizer(root.child("optimizer"));
+  {
+    Block b = root.child("render");
+    s.render = parse_render_spec(b);
+  }
+  root.finish();
+  return s;
+}
+
+Scene load_scene(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string() + ": cannot open scene file");
+  std::ostringstream os;
+  os << in.rdbuf();
+  if (!in && !in.eof()) throw InputError(file.string() + ": cannot read scene file");
+  return parse_scene(os.str(), file);
+}
+
+}  // namespace kf

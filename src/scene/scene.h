@@ -1,0 +1,36 @@
+#pragma once
+// A validated scene: the particle system, its keyframes, controls, optimiser settings and look.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scene/cloth_spec.h"
+#include "scene/flock_spec.h"
+#include "scene/objective_spec.h"
+#include "scene/render_spec.h"
+#include "scene/time_spec.h"
+
+namespace kf {
+
+struct Scene {
+  std::string name;                 // file name without .json
+  std::filesystem::path file;       // as given
+  std::filesystem::path directory;  // where relative asset paths start
+  unsigned seed = 1;
+  TimeSpec time;
+  std::optional<FlockSpec> flock;  // exactly one of flock, cloth
+  std::optional<ClothSpec> cloth;
+  std::vector<ObjectiveSpec> objectives;
+  ControlSpec controls;
+  OptimizerSpec optimizer;
+  RenderSpec render;
+  int particles() const;
+};
+
+// Loads and validates a scene file. Throws InputError with "file: /pointer: expected ..." on any problem.
+Scene load_scene(const std::filesystem::path& file);
+// The same from JSON text already in memory (used by tests and the fuzzer); `file` names it in messages.
+Scene parse_scene(const std::string& text, const std::filesystem::path& file);
+
+}  // namespace kf

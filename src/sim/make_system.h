@@ -1,0 +1,17 @@
+#pragma once
+// Builds the particle system a scene names, with only the forces and colliders it asks for.
+#include <memory>
+
+#include "scene/scene.h"
+#include "sim/system.h"
+
+namespace kf {
+
+// `h_override` > 0 replaces the scene's step length (gradcheck studies, coarse-to-fine).
+std::unique_ptr<System> make_system(const Scene& scene, double h_override = 0);
+
+// Implemented by each family.
+std::unique_ptr<System> make_flock_system(const Scene& scene, double h);
+std::unique_ptr<System> make_cloth_system(const Scene& scene, double h);
+
+}  // namespace kf

@@ -1,0 +1,44 @@
+#pragma once
+// A particle system with one integrator: the forward step and its adjoint side by side.
+//
+// State: positions x and velocities v, 3p entries each (metres, m/s, world frame, Y up).
+// Controls: an external force u_n (3p, newtons) applied during step n (n = 0 .. steps-1).
+// The step length h is fixed when the system is built from a scene.
+#include <string>
+
+#include "core/types.h"
+
+namespace kf {
+
+class System {
+ public:
+  virtual ~System() = default;
+
+  virtual int particles() const = 0;
+  int dof() const { return 3 * particles(); }
+  virtual double h() const = 0;
+  // Per-particle masses (p entries, kg).
+  virtual const VecX& masses() const = 0;
+  // Initial state at step 0 (the scene's; controls on initial velocity replace v afterwards).
+  virtual void initial_state(VecX& x, VecX& v) const = 0;
+  // True for flocks that live on the ground plane: the y components of x, v and u stay zero.
+  virtual bool planar() const { return false; }
+
+  // Advances the state of step n by one step under control force u. Returns false when the result is
+  // not finite or an inner solve failed; the caller treats that as a diverged simulation.
+  // Must not allocate after the first call.
+  virtual bool step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) = 0;
+
+  // Adjoint of step n, evaluated at the forward state (x, v) of step n and its control u.
+  // In:  xhat1, vhat1 = dphi/dx_{n+1}, dphi/dv_{n+1} (complete, including keyframe terms at n+1).
+  // Out: xhat, vhat   = the part of dphi/dx_n, dphi/dv_n that flows through this step
+  //                     (the caller adds the keyframe gradient of step n),
+  //      uhat         = dphi/du_n through the dynamics (the caller adds the effort term alpha*u_n).
+  virtual void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const VecX& xhat1,
+                            const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) = 0;
+
+  // One-line description for logs ("flock: 200 agents, grid neighbour search").
+  virtual std::string describe() const = 0;
+};
+
+}  // namespace kf
