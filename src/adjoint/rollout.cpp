@@ -10,6 +10,9 @@ bool simulate(System& sys, const VecX& x0, const VecX& v0, const std::vector<Vec
   r.v[0] = v0;
   r.diverged_at = -1;
   for (int n = 0; n < N; ++n) {
+    // Sized once; later rollouts reuse the storage.
+    if (r.x[n + 1].size() != x0.size()) r.x[n + 1].resize(x0.size());
+    if (r.v[n + 1].size() != x0.size()) r.v[n + 1].resize(x0.size());
     if (!sys.step(n, r.x[n], r.v[n], U[n], r.x[n + 1], r.v[n + 1])) {
       r.diverged_at = n;
       return false;

@@ -1,12 +1,29 @@
-// keyframe optimize: find the control forces that hit the keyframes.
+// keyframe optimize SCENE: find the control forces that hit the keyframes.
+#include <iostream>
+
 #include "app/commands.h"
+#include "app/optimize_job.h"
 
 namespace kf {
 
+void add_optimize_options(CLI::App* sub, OptimizeOptions& o) {
+  sub->add_option("--out", o.out, "run directory (default: out/<scene>/)");
+  sub->add_option("--max-evaluations", o.max_evaluations,
+                  "override the scene's optimizer.max_evaluations (each = one forward + one adjoint pass)")
+      ->check(CLI::Range(0, 1000000));
+  sub->add_flag("--quiet", o.quiet, "no line per evaluation, only a progress display");
+}
+
 void add_optimize_command(CLI::App& app) {
-  auto* sub = app.add_subcommand("optimize", "find the control forces that hit the keyframes (not available yet)");
-  sub->allow_extras();
-  sub->callback([] { throw NotReady("'optimize' is not available yet in this build"); });
+  auto* sub = app.add_subcommand("optimize",
+                                 "find the control forces that make the simulation hit the scene's keyframes "
+                                 "(adjoint gradient + L-BFGS); writes trajectory.bin, controls.bin, "
+                                 "iterations.csv, convergence.png, report.json");
+  auto scene = std::make_shared<std::string>();
+  auto opts = std::make_shared<OptimizeOptions>();
+  sub->add_option("SCENE", *scene, "scene file (JSON)")->required();
+  add_optimize_options(sub, *opts);
+  sub->callback([=] { optimize_job(*scene, *opts); });
 }
 
 }  // namespace kf

@@ -27,7 +27,7 @@ struct ControlSpec {
 };
 
 struct OptimizerSpec {
-  int max_iterations = 200;
+  int max_evaluations = 300;  // each one forward + one adjoint pass
   double ftol_rel = 1e-8;
   double max_seconds = 0;  // 0: no limit
   int memory = 10;         // L-BFGS vectors

@@ -69,7 +69,7 @@ ControlSpec parse_controls(Block b, const Scene& s) {
 
 OptimizerSpec parse_optimizer(Block b) {
   OptimizerSpec o;
-  o.max_iterations = b.integer("max_iterations", o.max_iterations, 0, 100000);
+  o.max_evaluations = b.integer("max_evaluations", o.max_evaluations, 0, 1000000);
   o.ftol_rel = b.number("ftol_rel", o.ftol_rel, 0.0, 1.0);
   o.max_seconds = b.number("max_seconds", o.max_seconds, 0.0, 1e7);
   o.memory = b.integer("memory", o.memory, 1, 100);

@@ -26,7 +26,7 @@ class System {
 
   // Advances the state of step n by one step under control force u. Returns false when the result is
   // not finite or an inner solve failed; the caller treats that as a diverged simulation.
-  // Must not allocate after the first call.
+  // x_next and v_next arrive sized 3p. Must not allocate after the first call.
   virtual bool step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) = 0;
 
   // Adjoint of step n, evaluated at the forward state (x, v) of step n and its control u.

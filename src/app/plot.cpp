@@ -1,0 +1,41 @@
+#include "app/plot.h"
+
+#include <cstdio>
+#include <iostream>
+#include <vector>
+
+namespace kf {
+namespace fs = std::filesystem;
+
+bool plot_csv(const fs::path& csv, const fs::path& png, const std::string& title, int x_col,
+              const std::vector<int>& y_cols, bool log_y) {
+  if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
+    std::cerr << "keyframe: note: gnuplot is not installed; skipped " << png.string() << "\n";
+    return false;
+  }
+  const fs::path tmp = png.parent_path() / ("." + png.filename().string() + ".tmp.png");
+  std::string script = "set terminal pngcairo size 900,540 font 'DejaVu Sans,11'\n";
+  script += "set output '" + tmp.string() + "'\n";
+  script += "set datafile separator ','\nset key autotitle columnhead\nset grid\n";
+  script += "set title '" + title + "'\n";
+  if (log_y) script += "set logscale y\nset format y '%.0e'\n";
+  script += "plot ";
+  for (size_t k = 0; k < y_cols.size(); ++k)
+    script += (k ? ", " : "") + ("'" + csv.string() + "' using " + std::to_string(x_col) + ":" +
+                                 std::to_string(y_cols[k]) + " with lines lw 2");
+  script += "\n";
+  FILE* gp = popen("gnuplot 2>/dev/null", "w");
+  if (!gp) return false;
+  std::fwrite(script.data(), 1, script.size(), gp);
+  const int rc = pclose(gp);
+  std::error_code ec;
+  if (rc != 0 || !fs::exists(tmp)) {
+    fs::remove(tmp, ec);
+    std::cerr << "keyframe: note: gnuplot failed; skipped " << png.string() << "\n";
+    return false;
+  }
+  fs::rename(tmp, png, ec);
+  return !ec;
+}
+
+}  // namespace kf

@@ -1,0 +1,69 @@
+#include "opt/controls.h"
+
+namespace kf {
+
+Controls::Controls(const ControlSpec& spec, const TimeSpec& time, int particles, bool planar, const VecX& v0_scene)
+    : kind_(spec.kind), alpha_(spec.alpha), steps_(time.steps()), substeps_(time.substeps), particles_(particles),
+      h_(time.h()), v0_scene_(v0_scene) {
+  comps_ = planar ? std::vector<int>{0, 2} : std::vector<int>{0, 1, 2};
+  blocks_ = kind_ == "per_step" ? steps_ : kind_ == "per_frame" ? time.frames : 1;
+}
+
+VecX Controls::initial_guess() const {
+  VecX z = VecX::Zero(size());
+  if (kind_ == "initial_velocity") {
+    const int nc = int(comps_.size());
+    for (int i = 0; i < particles_; ++i)
+      for (int c = 0; c < nc; ++c) z[i * nc + c] = v0_scene_[3 * i + comps_[c]];
+  }
+  return z;
+}
+
+void Controls::expand(const VecX& z, VecX& v0, std::vector<VecX>& U) const {
+  const int nc = int(comps_.size()), dof = 3 * particles_, stride = particles_ * nc;
+  U.resize(steps_);
+  for (auto& u : U) {
+    if (u.size() != dof) u.resize(dof);
+    u.setZero();
+  }
+  v0 = v0_scene_;
+  if (kind_ == "initial_velocity") {
+    for (int i = 0; i < particles_; ++i)
+      for (int c = 0; c < nc; ++c) v0[3 * i + comps_[c]] = z[i * nc + c];
+    return;
+  }
+  for (int n = 0; n < steps_; ++n) {
+    const int b = kind_ == "per_step" ? n : n / substeps_;
+    for (int i = 0; i < particles_; ++i)
+      for (int c = 0; c < nc; ++c) U[n][3 * i + comps_[c]] = z[b * stride + i * nc + c];
+  }
+}
+
+void Controls::gather(const std::vector<VecX>& dU, const VecX& dv0, VecX& dz) const {
+  const int nc = int(comps_.size()), stride = particles_ * nc;
+  dz.setZero(size());
+  if (kind_ == "initial_velocity") {
+    for (int i = 0; i < particles_; ++i)
+      for (int c = 0; c < nc; ++c) dz[i * nc + c] = dv0[3 * i + comps_[c]];
+    return;
+  }
+  for (int n = 0; n < steps_; ++n) {
+    const int b = kind_ == "per_step" ? n : n / substeps_;
+    for (int i = 0; i < particles_; ++i)
+      for (int c = 0; c < nc; ++c) dz[b * stride + i * nc + c] += dU[n][3 * i + comps_[c]];
+  }
+}
+
+double Controls::effort(const VecX& z, VecX& dz) const {
+  if (kind_ == "initial_velocity") {
+    const VecX d = z - initial_guess();
+    dz += alpha_ * d;
+    return 0.5 * alpha_ * d.squaredNorm();
+  }
+  // Time-integral of ‖u‖²: a frame's force acts for `substeps` steps of length h.
+  const double dt = kind_ == "per_step" ? h_ : h_ * substeps_;
+  dz += alpha_ * dt * z;
+  return 0.5 * alpha_ * dt * z.squaredNorm();
+}
+
+}  // namespace kf

@@ -1,0 +1,38 @@
+#pragma once
+// How the optimisation variables z become control forces: one force per particle per step (paper),
+// one per particle per frame held over its substeps (Stuyck ch. 8), or the initial velocities only.
+// Ground-bound (planar) systems get no y components.
+#include <vector>
+
+#include "core/types.h"
+#include "scene/objective_spec.h"
+#include "scene/time_spec.h"
+
+namespace kf {
+
+class Controls {
+ public:
+  // dof = 3p; v0_scene: the scene's initial velocities (the reference for initial-velocity control).
+  Controls(const ControlSpec& spec, const TimeSpec& time, int particles, bool planar, const VecX& v0_scene);
+
+  int size() const { return blocks_ * particles_ * int(comps_.size()); }
+  const std::string& kind() const { return kind_; }
+  // The starting point of the optimisation: no force, or the scene's initial velocities.
+  VecX initial_guess() const;
+  // z (size()) -> initial velocities v0 (3p) and per-step forces U (N entries of 3p, resized here).
+  void expand(const VecX& z, VecX& v0, std::vector<VecX>& U) const;
+  // Chain rule back: dphi/dU and dphi/dv0 -> dphi/dz (overwrites dz).
+  void gather(const std::vector<VecX>& dU, const VecX& dv0, VecX& dz) const;
+  // Control effort ½α∫‖u‖²dt (forces) or ½α‖v0 − v0_scene‖² (initial velocities); adds its gradient.
+  double effort(const VecX& z, VecX& dz) const;
+
+ private:
+  std::string kind_;
+  double alpha_;
+  int steps_, substeps_, particles_, blocks_;
+  double h_;
+  std::vector<int> comps_;  // which of x, y, z are controlled
+  VecX v0_scene_;
+};
+
+}  // namespace kf

@@ -1,0 +1,115 @@
+#include "opt/measures.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "opt/objective_terms.h"
+
+namespace kf {
+
+std::vector<double> nearest_neighbour_spacing(const VecX& x) {
+  const int p = int(x.size() / 3);
+  std::vector<double> nn(p, std::numeric_limits<double>::infinity());
+  for (int i = 0; i < p; ++i)
+    for (int j = i + 1; j < p; ++j) {
+      const double d = std::hypot(x[3 * i] - x[3 * j], x[3 * i + 2] - x[3 * j + 2]);
+      nn[i] = std::min(nn[i], d);
+      nn[j] = std::min(nn[j], d);
+    }
+  return nn;
+}
+
+namespace {
+
+Vec3 mean_of(const VecX& x, const std::vector<int>& ids) {
+  Vec3 m = Vec3::Zero();
+  if (ids.empty()) {
+    for (int i = 0; i < x.size() / 3; ++i) m += seg(x, i);
+    return m / double(x.size() / 3);
+  }
+  for (int i : ids) m += seg(x, i);
+  return m / double(ids.size());
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+}  // namespace
+
+nlohmann::json figure_measures(const Scene& scene, const Trajectory& t) {
+  nlohmann::json out = nlohmann::json::array();
+  const int last = t.frames() - 1;
+  for (const auto& o : scene.objectives) {
+    const int f = std::min(o.frame, last);
+    const VecX& x = t.x[f];
+    nlohmann::json m = {{"type", o.type}, {"frame", o.frame}};
+    if (o.type == "shape") {
+      int inside = 0;
+      const int p = int(x.size() / 3);
+      for (int i = 0; i < p; ++i) inside += polygon_contains(o.polygon, Vec2(x[3 * i], x[3 * i + 2]));
+      const auto nn = nearest_neighbour_spacing(x);
+      m["inside_fraction"] = double(inside) / p;
+      m["min_spacing"] = *std::min_element(nn.begin(), nn.end());
+      m["median_spacing"] = median(nn);
+    } else if (o.type == "center_of_mass") {
+      // Path: the start's centre of mass, then every centre-of-mass target in frame order.
+      std::vector<std::pair<int, Vec3>> pts{{0, mean_of(t.x[0], o.particles)}};
+      for (const auto& q : scene.objectives)
+        if (q.type == "center_of_mass") pts.emplace_back(q.frame, q.targets[0]);
+      std::stable_sort(pts.begin(), pts.end(), [](auto& a, auto& b) { return a.first < b.first; });
+      double length = 0;
+      for (size_t k = 1; k < pts.size(); ++k) length += (pts[k].second - pts[k - 1].second).norm();
+      const double err = (mean_of(x, o.particles) - o.targets[0]).norm();
+      m["error"] = err;
+      m["path_length"] = length;
+      m["error_over_path"] = length > 0 ? err / length : 0.0;
+    } else if (o.type == "position" && scene.flock && o.particles.size() == 1) {
+      const int a = o.particles[0];
+      Vec3 heading = mean_of(t.x[f], {}) - mean_of(t.x[0], {});
+      if (heading.norm() < 1e-12) heading = Vec3::UnitX();
+      heading.normalize();
+      auto rank = [&](const VecX& s) {
+        const double mine = seg(s, a).dot(heading);
+        int r = 0;
+        for (int i = 0; i < s.size() / 3; ++i) r += (i != a && seg(s, i).dot(heading) < mine);
+        return r;
+      };
+      const int p = int(x.size() / 3);
+      const int r0 = rank(t.x[0]), r1 = rank(x);
+      m["rank_at_start"] = r0;
+      m["rank_at_end"] = r1;
+      m["last_at_start"] = r0 == 0;
+      m["first_at_end"] = r1 == p - 1;
+      m["rms_error"] = (seg(x, a) - o.targets[0]).norm();
+    } else if (o.type == "position" || o.type == "velocity") {
+      const VecX& q = o.type == "position" ? x : t.v[f];
+      double sum = 0;
+      const int n = o.particles.empty() ? int(q.size() / 3) : int(o.particles.size());
+      for (int k = 0; k < n; ++k) {
+        const int i = o.particles.empty() ? k : o.particles[k];
+        sum += (seg(q, i) - o.targets[o.targets.size() == 1 ? 0 : k]).squaredNorm();
+      }
+      m["rms_error"] = std::sqrt(sum / n);
+    } else if (o.type == "arch") {
+      double sum = 0;
+      const int p = int(x.size() / 3);
+      for (int i = 0; i < p; ++i) {
+        const Vec3 d = seg(x, i) - o.axis_point;
+        const double e = (d - d.dot(o.axis) * o.axis).norm() - o.radius;
+        sum += e * e;
+      }
+      const int nx = scene.cloth ? scene.cloth->nx : 1;
+      const double width = (seg(t.x[0], nx - 1) - seg(t.x[0], 0)).norm();
+      m["rms_distance"] = std::sqrt(sum / p);
+      m["width"] = width;
+      m["rms_over_width"] = width > 0 ? std::sqrt(sum / p) / width : 0.0;
+    }
+    out.push_back(m);
+  }
+  return out;
+}
+
+}  // namespace kf

@@ -1,0 +1,164 @@
+#include "opt/objective_terms.h"
+
+#include <cmath>
+#include <limits>
+
+namespace kf {
+
+bool polygon_contains(const std::vector<Vec2>& poly, const Vec2& q) {
+  bool inside = false;  // even-odd rule
+  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    const Vec2 &a = poly[i], &b = poly[j];
+    if ((a.y() > q.y()) != (b.y() > q.y()) && q.x() < (b.x() - a.x()) * (q.y() - a.y()) / (b.y() - a.y()) + a.x())
+      inside = !inside;
+  }
+  return inside;
+}
+
+Vec2 closest_point_in_polygon(const std::vector<Vec2>& poly, const Vec2& q, bool* inside) {
+  const bool in = polygon_contains(poly, q);
+  if (inside) *inside = in;
+  if (in) return q;
+  double best = std::numeric_limits<double>::infinity();
+  Vec2 best_p = q;
+  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    const Vec2 a = poly[j], e = poly[i] - poly[j];
+    const double len2 = e.squaredNorm();
+    const double t = len2 > 0 ? std::clamp((q - a).dot(e) / len2, 0.0, 1.0) : 0.0;
+    const Vec2 p = a + t * e;
+    const double d = (q - p).squaredNorm();
+    if (d < best) {
+      best = d;
+      best_p = p;
+    }
+  }
+  return best_p;
+}
+
+namespace {
+
+// Particle indices a term applies to: the listed ones, or all.
+std::vector<int> members(const ObjectiveSpec& s, int particles) {
+  if (!s.particles.empty()) return s.particles;
+  std::vector<int> all(particles);
+  for (int i = 0; i < particles; ++i) all[i] = i;
+  return all;
+}
+
+// ½w Σ‖x_i − t_i‖² (position) or ½w Σ‖v_i − t_i‖² (velocity).
+class KeyframeTerm : public ObjectiveTerm {
+ public:
+  KeyframeTerm(const ObjectiveSpec& s, int p, bool on_velocity)
+      : frame_(s.frame), w_(s.weight), ids_(members(s, p)), targets_(s.targets), on_velocity_(on_velocity) {}
+  std::string name() const override { return on_velocity_ ? "velocity" : "position"; }
+  int frame() const override { return frame_; }
+  double eval(const VecX& x, const VecX& v, VecX& gx, VecX& gv) const override {
+    const VecX& q = on_velocity_ ? v : x;
+    VecX& g = on_velocity_ ? gv : gx;
+    double val = 0;
+    for (size_t k = 0; k < ids_.size(); ++k) {
+      const Vec3 d = seg(q, ids_[k]) - targets_[targets_.size() == 1 ? 0 : k];
+      val += 0.5 * w_ * d.squaredNorm();
+      seg(g, ids_[k]) += w_ * d;
+    }
+    return val;
+  }
+
+ private:
+  int frame_;
+  double w_;
+  std::vector<int> ids_;
+  std::vector<Vec3> targets_;
+  bool on_velocity_;
+};
+
+// ½w‖x̄ − c‖² with x̄ the mean position of the members.
+class CenterOfMassTerm : public ObjectiveTerm {
+ public:
+  CenterOfMassTerm(const ObjectiveSpec& s, int p)
+      : frame_(s.frame), w_(s.weight), ids_(members(s, p)), target_(s.targets.at(0)) {}
+  std::string name() const override { return "center_of_mass"; }
+  int frame() const override { return frame_; }
+  double eval(const VecX& x, const VecX&, VecX& gx, VecX&) const override {
+    Vec3 mean = Vec3::Zero();
+    for (int i : ids_) mean += seg(x, i);
+    mean /= double(ids_.size());
+    const Vec3 d = mean - target_;
+    const Vec3 g = w_ * d / double(ids_.size());
+    for (int i : ids_) seg(gx, i) += g;
+    return 0.5 * w_ * d.squaredNorm();
+  }
+
+ private:
+  int frame_;
+  double w_;
+  std::vector<int> ids_;
+  Vec3 target_;
+};
+
+// ½w Σ dist(x_i, S)² over agents outside a ground region S given as a polygon in (x, z).
+class ShapeTerm : public ObjectiveTerm {
+ public:
+  ShapeTerm(const ObjectiveSpec& s, int p) : frame_(s.frame), w_(s.weight), ids_(members(s, p)), poly_(s.polygon) {}
+  std::string name() const override { return "shape"; }
+  int frame() const override { return frame_; }
+  double eval(const VecX& x, const VecX&, VecX& gx, VecX&) const override {
+    double val = 0;
+    for (int i : ids_) {
+      const Vec2 q(x[3 * i], x[3 * i + 2]);
+      const Vec2 d = q - closest_point_in_polygon(poly_, q);
+      val += 0.5 * w_ * d.squaredNorm();
+      gx[3 * i] += w_ * d.x();
+      gx[3 * i + 2] += w_ * d.y();
+    }
+    return val;
+  }
+
+ private:
+  int frame_;
+  double w_;
+  std::vector<int> ids_;
+  std::vector<Vec2> poly_;
+};
+
+// ½w Σ (‖r⊥_i‖ − R)², r⊥ the offset of x_i from the cylinder axis: cloth onto an arch.
+class ArchTerm : public ObjectiveTerm {
+ public:
+  ArchTerm(const ObjectiveSpec& s, int p)
+      : frame_(s.frame), w_(s.weight), ids_(members(s, p)), a_(s.axis_point), e_(s.axis), r_(s.radius) {}
+  std::string name() const override { return "arch"; }
+  int frame() const override { return frame_; }
+  double eval(const VecX& x, const VecX&, VecX& gx, VecX&) const override {
+    double val = 0;
+    for (int i : ids_) {
+      const Vec3 d = seg(x, i) - a_;
+      const Vec3 perp = d - d.dot(e_) * e_;
+      const double len = perp.norm();
+      if (len < 1e-12) continue;  // on the axis the distance is not differentiable; no pull
+      const double err = len - r_;
+      val += 0.5 * w_ * err * err;
+      seg(gx, i) += w_ * err * perp / len;
+    }
+    return val;
+  }
+
+ private:
+  int frame_;
+  double w_;
+  std::vector<int> ids_;
+  Vec3 a_, e_;
+  double r_;
+};
+
+}  // namespace
+
+std::unique_ptr<ObjectiveTerm> make_objective_term(const ObjectiveSpec& s, int particles) {
+  if (s.type == "position") return std::make_unique<KeyframeTerm>(s, particles, false);
+  if (s.type == "velocity") return std::make_unique<KeyframeTerm>(s, particles, true);
+  if (s.type == "center_of_mass") return std::make_unique<CenterOfMassTerm>(s, particles);
+  if (s.type == "shape") return std::make_unique<ShapeTerm>(s, particles);
+  if (s.type == "arch") return std::make_unique<ArchTerm>(s, particles);
+  throw std::invalid_argument("unknown objective type " + s.type);
+}
+
+}  // namespace kf

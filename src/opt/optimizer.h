@@ -1,0 +1,38 @@
+#pragma once
+// L-BFGS (NLopt LD_LBFGS) on a Problem, keeping the best point and a record of every evaluation.
+#include <atomic>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "opt/problem.h"
+#include "scene/objective_spec.h"
+
+namespace kf {
+
+struct EvaluationRecord {
+  int evaluation = 0;  // 1-based count of φ evaluations (each one forward + one adjoint pass)
+  double phi = 0;
+  double grad_norm = 0;
+  double seconds = 0;  // since the start of the optimisation
+  bool diverged = false;
+  std::vector<std::pair<std::string, double>> terms;
+};
+
+struct OptimizeResult {
+  VecX z;               // best point found
+  double phi = 0;       // φ at z
+  int evaluations = 0;
+  double seconds = 0;
+  std::string status;   // why it stopped
+  bool interrupted = false;
+  std::vector<EvaluationRecord> history;
+};
+
+// Minimises φ from z0. `on_eval` sees each evaluation as it happens; setting *stop makes the next
+// evaluation end the optimisation with the best point so far (used for SIGINT/SIGTERM).
+OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX& z0,
+                        const std::function<void(const EvaluationRecord&)>& on_eval = {},
+                        const std::atomic<bool>* stop = nullptr);
+
+}  // namespace kf

@@ -1,0 +1,58 @@
+#pragma once
+// The optimisation problem φ(z): simulate under the controls z, sum the keyframe terms and the control
+// effort, and get dφ/dz from one adjoint pass.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "adjoint/rollout.h"
+#include "opt/controls.h"
+#include "opt/objective_terms.h"
+#include "scene/scene.h"
+#include "sim/system.h"
+
+namespace kf {
+
+class Problem : public StateCost {
+ public:
+  // `time` may differ from the scene's (a finer or coarser substep count); keyframes stay on frames.
+  Problem(const Scene& scene, const TimeSpec& time, System& sys);
+
+  int size() const { return controls_.size(); }
+  const Controls& controls() const { return controls_; }
+  const TimeSpec& time() const { return time_; }
+  System& system() { return sys_; }
+  VecX initial_guess() const { return controls_.initial_guess(); }
+
+  // φ(z); when grad is given, also dφ/dz. A simulation that diverges gives a large finite φ that grows
+  // away from the last good point (so a line search backs off) and never NaN.
+  double evaluate(const VecX& z, VecX* grad);
+  bool last_diverged() const { return diverged_; }
+
+  // Values of each term (keyframe terms by name, then "effort") at the last evaluated point.
+  const std::vector<std::pair<std::string, double>>& breakdown() const { return breakdown_; }
+  // The states of the last evaluated point (valid unless it diverged).
+  const Rollout& rollout() const { return rollout_; }
+
+  // StateCost: keyframe terms at the steps of their frames.
+  bool active(int n) const override;
+  double eval(int n, const VecX& x, const VecX& v, VecX& gx, VecX& gv) const override;
+
+ private:
+  TimeSpec time_;
+  System& sys_;
+  Controls controls_;
+  std::vector<std::unique_ptr<ObjectiveTerm>> terms_;
+  std::vector<std::vector<int>> terms_at_step_;  // term indices per step
+  VecX x0_, v0_scene_, v0_;
+  std::vector<VecX> U_, dU_;
+  VecX dx0_, dv0_;
+  Rollout rollout_;
+  bool diverged_ = false;
+  bool have_good_ = false;
+  VecX z_good_;
+  double phi_good_ = 0;
+  std::vector<std::pair<std::string, double>> breakdown_;
+};
+
+}  // namespace kf
