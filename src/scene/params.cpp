@@ -25,8 +25,14 @@ Block::Block(const Json& j, std::string file, std::string pointer)
 std::string Block::pointer(const std::string& key) const { return pointer_ + "/" + pointer_escape(key); }
 
 void Block::fail(const std::string& key, const std::string& expected) const {
-  throw InputError(file_ + ": " + pointer(key) + ": " + expected);
+  fail_rel("/" + pointer_escape(key), expected);
 }
+
+void Block::fail_rel(const std::string& rel, const std::string& expected) const {
+  throw InputError(file_ + ": " + pointer_ + rel + ": " + expected);
+}
+
+std::string Block::rel(const std::string& key) { return "/" + pointer_escape(key); }
 
 void Block::fail_here(const std::string& expected) const {
   throw InputError(file_ + ": " + (pointer_.empty() ? std::string("/") : pointer_) + ": " + expected);
@@ -53,41 +59,41 @@ const Json& Block::required(const std::string& key) {
   return *v;
 }
 
-double Block::as_number(const Json& v, const std::string& key, double lo, double hi) const {
-  if (!v.is_number()) fail(key, "expected a number, got " + describe(v));
+double Block::as_number(const Json& v, const std::string& at, double lo, double hi) const {
+  if (!v.is_number()) fail_rel(at, "expected a number, got " + describe(v));
   double d = v.get<double>();
-  if (!std::isfinite(d)) fail(key, "expected a finite number");
+  if (!std::isfinite(d)) fail_rel(at, "expected a finite number");
   if (d < lo || d > hi) {
     std::ostringstream os;
     os << "expected a number in [" << lo << ", " << hi << "], got " << d;
-    fail(key, os.str());
+    fail_rel(at, os.str());
   }
   return d;
 }
 
 double Block::number(const std::string& key, double def, double lo, double hi) {
   const Json* v = find(key);
-  return v ? as_number(*v, key, lo, hi) : def;
+  return v ? as_number(*v, rel(key), lo, hi) : def;
 }
 
-double Block::number(const std::string& key, double lo, double hi) { return as_number(required(key), key, lo, hi); }
+double Block::number(const std::string& key, double lo, double hi) { return as_number(required(key), rel(key), lo, hi); }
 
-static int to_int(const Block& b, const Json& v, const std::string& key, int lo, int hi) {
+static int to_int(const Block& b, const Json& v, const std::string& at, int lo, int hi) {
   if (!v.is_number_integer() && !(v.is_number_float() && std::floor(v.get<double>()) == v.get<double>() &&
                                    std::isfinite(v.get<double>())))
-    b.fail(key, "expected an integer, got " + std::string(v.type_name()) + " " + v.dump());
+    b.fail_rel(at, "expected an integer, got " + std::string(v.type_name()) + " " + v.dump());
   double d = v.get<double>();
   if (d < lo || d > hi)
-    b.fail(key, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + v.dump());
+    b.fail_rel(at, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + v.dump());
   return int(d);
 }
 
 int Block::integer(const std::string& key, int def, int lo, int hi) {
   const Json* v = find(key);
-  return v ? to_int(*this, *v, key, lo, hi) : def;
+  return v ? to_int(*this, *v, rel(key), lo, hi) : def;
 }
 
-int Block::integer(const std::string& key, int lo, int hi) { return to_int(*this, required(key), key, lo, hi); }
+int Block::integer(const std::string& key, int lo, int hi) { return to_int(*this, required(key), rel(key), lo, hi); }
 
 bool Block::boolean(const std::string& key, bool def) {
   const Json* v = find(key);
@@ -124,7 +130,7 @@ std::vector<double> Block::numbers(const std::string& key, int min_count, double
   if (!v.is_array() || int(v.size()) < min_count)
     fail(key, "expected an array of at least " + std::to_string(min_count) + " numbers, got " + describe(v));
   std::vector<double> out;
-  for (size_t i = 0; i < v.size(); ++i) out.push_back(as_number(v[i], key + "/" + std::to_string(i), lo, hi));
+  for (size_t i = 0; i < v.size(); ++i) out.push_back(as_number(v[i], rel(key) + "/" + std::to_string(i), lo, hi));
   return out;
 }
 
@@ -133,16 +139,16 @@ std::vector<int> Block::integers(const std::string& key, int min_count, int lo, 
   if (!v.is_array() || int(v.size()) < min_count)
     fail(key, "expected an array of at least " + std::to_string(min_count) + " integers, got " + describe(v));
   std::vector<int> out;
-  for (size_t i = 0; i < v.size(); ++i) out.push_back(to_int(*this, v[i], key + "/" + std::to_string(i), lo, hi));
+  for (size_t i = 0; i < v.size(); ++i) out.push_back(to_int(*this, v[i], rel(key) + "/" + std::to_string(i), lo, hi));
   return out;
 }
 
-static Vec3 to_vec3(const Block& b, const Json& v, const std::string& key, double lo, double hi) {
-  if (!v.is_array() || v.size() != 3) b.fail(key, "expected [x, y, z], got " + std::string(v.type_name()) + " " + v.dump());
+static Vec3 to_vec3(const Block& b, const Json& v, const std::string& at, double lo, double hi) {
+  if (!v.is_array() || v.size() != 3) b.fail_rel(at, "expected [x, y, z], got " + std::string(v.type_name()) + " " + v.dump());
   Vec3 out;
   for (int i = 0; i < 3; ++i) {
     if (!v[i].is_number() || !std::isfinite(v[i].get<double>()) || v[i].get<double>() < lo || v[i].get<double>() > hi)
-      b.fail(key + "/" + std::to_string(i), "expected a finite number in [" + std::to_string(lo) + ", " +
+      b.fail_rel(at + "/" + std::to_string(i), "expected a finite number in [" + std::to_string(lo) + ", " +
                                                  std::to_string(hi) + "], got " + v[i].dump());
     out[i] = v[i].get<double>();
   }
@@ -151,10 +157,10 @@ static Vec3 to_vec3(const Block& b, const Json& v, const std::string& key, doubl
 
 Vec3 Block::vec3(const std::string& key, const Vec3& def, double lo, double hi) {
   const Json* v = find(key);
-  return v ? to_vec3(*this, *v, key, lo, hi) : def;
+  return v ? to_vec3(*this, *v, rel(key), lo, hi) : def;
 }
 
-Vec3 Block::vec3(const std::string& key, double lo, double hi) { return to_vec3(*this, required(key), key, lo, hi); }
+Vec3 Block::vec3(const std::string& key, double lo, double hi) { return to_vec3(*this, required(key), rel(key), lo, hi); }
 
 std::vector<Vec2> Block::points2(const std::string& key, int min_count, double lo, double hi) {
   const Json& v = required(key);
@@ -163,8 +169,8 @@ std::vector<Vec2> Block::points2(const std::string& key, int min_count, double l
   std::vector<Vec2> out;
   for (size_t i = 0; i < v.size(); ++i) {
     const Json& p = v[i];
-    const std::string k = key + "/" + std::to_string(i);
-    if (!p.is_array() || p.size() != 2) fail(k, "expected [a, b], got " + describe(p));
+    const std::string k = rel(key) + "/" + std::to_string(i);
+    if (!p.is_array() || p.size() != 2) fail_rel(k, "expected [a, b], got " + describe(p));
     Vec2 q(as_number(p[0], k + "/0", lo, hi), as_number(p[1], k + "/1", lo, hi));
     out.push_back(q);
   }
@@ -176,7 +182,7 @@ std::vector<Vec3> Block::points3(const std::string& key, int min_count, double l
   if (!v.is_array() || int(v.size()) < min_count)
     fail(key, "expected a list of at least " + std::to_string(min_count) + " [x, y, z] points, got " + describe(v));
   std::vector<Vec3> out;
-  for (size_t i = 0; i < v.size(); ++i) out.push_back(to_vec3(*this, v[i], key + "/" + std::to_string(i), lo, hi));
+  for (size_t i = 0; i < v.size(); ++i) out.push_back(to_vec3(*this, v[i], rel(key) + "/" + std::to_string(i), lo, hi));
   return out;
 }
 
@@ -205,7 +211,7 @@ std::vector<Block> Block::array(const std::string& key, int min_count) {
     fail(key, "expected an array of at least " + std::to_string(min_count) + " objects, got " + describe(*v));
   std::vector<Block> out;
   for (size_t i = 0; i < v->size(); ++i) {
-    if (!(*v)[i].is_object()) fail(key + "/" + std::to_string(i), "expected an object, got " + describe((*v)[i]));
+    if (!(*v)[i].is_object()) fail_rel(rel(key) + "/" + std::to_string(i), "expected an object, got " + describe((*v)[i]));
     out.emplace_back((*v)[i], file_, pointer(key) + "/" + std::to_string(i));
   }
   return out;

@@ -45,6 +45,8 @@ class Block {
   void finish() const;
   [[noreturn]] void fail(const std::string& key, const std::string& expected) const;
   [[noreturn]] void fail_here(const std::string& expected) const;
+  // `rel`: an escaped pointer below this block, such as "/targets/2".
+  [[noreturn]] void fail_rel(const std::string& rel, const std::string& expected) const;
   std::string pointer(const std::string& key) const;
   const std::string& file() const { return file_; }
   const Json& json() const { return j_; }
@@ -54,6 +56,7 @@ class Block {
   const Json& required(const std::string& key);
   double as_number(const Json& v, const std::string& key, double lo, double hi) const;
   static std::string describe(const Json& v);
+  static std::string rel(const std::string& key);
 
   Json j_;
   std::string file_, pointer_;

@@ -88,6 +88,10 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& file) {
     std::string what = e.what();
     auto pos = what.find("parse error");
     throw InputError(file.string() + ": not valid JSON: " + (pos == std::string::npos ? what : what.substr(pos)));
+  } catch (const Json::exception& e) {
+    std::string what = e.what();
+    auto pos = what.find("] ");
+    throw InputError(file.string() + ": not valid JSON: " + (pos == std::string::npos ? what : what.substr(pos + 2)));
   }
   Scene s;
   s.file = file;
