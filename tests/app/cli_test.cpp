@@ -1,0 +1,73 @@
+// The keyframe command as a user meets it: exit codes, one-line errors, nothing written on bad input.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "core/error.h"
+
+namespace kf {
+namespace {
+namespace fs = std::filesystem;
+
+struct Result {
+  int code;
+  std::string output;  // stdout and stderr together
+};
+
+Result run(const std::string& args, const fs::path& cwd) {
+  const std::string cmd = "cd '" + cwd.string() + "' && '" KEYFRAME_BINARY "' " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
+  const int status = pclose(p);
+  return {WEXITSTATUS(status), out};
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("keyframe_cli_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  void write(const std::string& name, const std::string& text) { std::ofstream(dir_ / name) << text; }
+  fs::path dir_;
+};
+
+TEST_F(Cli, HelpListsEverySubcommand) {
+  const Result r = run("--help", dir_);
+  EXPECT_EQ(r.code, 0);
+  for (const char* sub : {"simulate", "optimize", "run", "render", "gradcheck", "figure"})
+    EXPECT_NE(r.output.find(sub), std::string::npos) << sub;
+}
+
+TEST_F(Cli, UnknownSubcommandIsAUsageError) {
+  EXPECT_EQ(run("explode", dir_).code, kExitUsage);
+  EXPECT_EQ(run("simulate", dir_).code, kExitUsage);  // SCENE missing
+}
+
+TEST_F(Cli, BadSceneGivesOneLineAndWritesNothing) {
+  write("bad.json", R"({"time": {"fps": -1}, "flock": {"agents": 10}})");
+  for (const char* cmd : {"simulate", "optimize", "run", "gradcheck"}) {
+    const Result r = run(std::string(cmd) + " bad.json", dir_);
+    EXPECT_EQ(r.code, kExitInput) << cmd << ": " << r.output;
+    EXPECT_EQ(r.output, "keyframe: error: bad.json: /time/fps: expected a number in [1, 10000], got -1\n") << cmd;
+    EXPECT_FALSE(fs::exists(dir_ / "out")) << cmd << " wrote output for a bad scene";
+  }
+}
+
+TEST_F(Cli, MissingSceneFileIsNamed) {
+  const Result r = run("simulate nowhere.json", dir_);
+  EXPECT_EQ(r.code, kExitInput);
+  EXPECT_EQ(r.output, "keyframe: error: nowhere.json: cannot open scene file\n");
+}
+
+}  // namespace
+}  // namespace kf
