@@ -156,33 +156,59 @@ TEST(FlockSystem, RolloutGradientMatchesFiniteDifferences) {
   const double phi0 = phi(x0, v0, U);
   ASSERT_GT(phi0, 0.1);
   const double eps = 1e-5;
-  // Stack [dU_0 .. dU_{N-1}, dx0, dv0] and the finite differences the same way.
-  VecX analytic(3 * p * (N + 2)), fd = VecX::Zero(3 * p * (N + 2));
-  for (int n = 0; n < N; ++n) analytic.segment(3 * p * n, 3 * p) = dU[n];
-  analytic.segment(3 * p * N, 3 * p) = dx0;
-  analytic.segment(3 * p * (N + 1), 3 * p) = dv0;
-  for (int n = 0; n < N + 2; ++n)
+  // Every entry of dphi/du_n on steps at the start, around the mid keyframe and at the end, and of
+  // dphi/dx0, dphi/dv0 (slots N and N+1); stacked with the finite differences the same way.
+  const std::vector<int> slots = {0, 1, 2, 29, 30, 31, 57, 58, 59, N, N + 1};
+  VecX analytic(3 * p * int(slots.size())), fd = VecX::Zero(analytic.size());
+  for (size_t s = 0; s < slots.size(); ++s) {
+    const int n = slots[s];
+    analytic.segment(3 * p * s, 3 * p) = n < N ? dU[n] : n == N ? dx0 : dv0;
     for (int k = 0; k < 3 * p; ++k) {
       if (k % 3 == 1) {
-        ASSERT_EQ(analytic[3 * p * n + k], 0.0);
+        ASSERT_EQ(analytic[3 * p * s + k], 0.0);
         continue;
       }
       std::vector<VecX> Up = U, Um = U;
       VecX xp = x0, xm = x0, vp = v0, vm = v0;
-      if (n < N) Up[n][k] += eps, Um[n][k] -= eps;
-      else if (n == N) xp[k] += eps, xm[k] -= eps;
-      else vp[k] += eps, vm[k] -= eps;
-      fd[3 * p * n + k] = (phi(xp, vp, Up) - phi(xm, vm, Um)) / (2 * eps);
+      if (n < N) {
+        Up[n][k] += eps;
+        Um[n][k] -= eps;
+      } else if (n == N) {
+        xp[k] += eps;
+        xm[k] -= eps;
+      } else {
+        vp[k] += eps;
+        vm[k] -= eps;
+      }
+      fd[3 * p * s + k] = (phi(xp, vp, Up) - phi(xm, vm, Um)) / (2 * eps);
     }
+  }
   ASSERT_GT(fd.cwiseAbs().maxCoeff(), 1e-3);
   const double rel_inf = (analytic - fd).cwiseAbs().maxCoeff() / fd.cwiseAbs().maxCoeff();
   const double rel_floor = max_relative_error(analytic, fd, 1e-3);
+  // Every other step through random directions over all controls at once: g . delta vs d phi along delta.
+  double rel_dir = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    std::vector<VecX> Up = U, Um = U;
+    double g_delta = 0;
+    for (int n = 0; n < N; ++n) {
+      const VecX delta = random_planar(p, 1.0, rng);
+      Up[n] += eps * delta;
+      Um[n] -= eps * delta;
+      g_delta += dU[n].dot(delta);
+    }
+    const double fd_delta = (phi(x0, v0, Up) - phi(x0, v0, Um)) / (2 * eps);
+    ASSERT_GT(std::abs(fd_delta), 1e-3);
+    rel_dir = std::max(rel_dir, std::abs(g_delta - fd_delta) / std::abs(fd_delta));
+  }
   RecordProperty("relative_error_inf_norm", std::to_string(rel_inf));
   RecordProperty("relative_error_per_entry_floor_1e-3", std::to_string(rel_floor));
-  std::printf("rollout gradient: phi %.6g, max |grad| %.3g, max|a-fd|/max|fd| %.3g, per-entry (floor 1e-3 max) %.3g\n",
-              phi0, fd.cwiseAbs().maxCoeff(), rel_inf, rel_floor);
+  std::printf("rollout gradient: phi %.6g, max |grad| %.3g, max|a-fd|/max|fd| %.3g, per-entry (floor 1e-3 max) %.3g, "
+              "directional %.3g\n",
+              phi0, fd.cwiseAbs().maxCoeff(), rel_inf, rel_floor, rel_dir);
   EXPECT_LT(rel_inf, 1e-6);
   EXPECT_LT(rel_floor, 1e-6);
+  EXPECT_LT(rel_dir, 1e-6);
 }
 
 TEST(FlockSystem, BitIdenticalForOneAndTwoThreads) {

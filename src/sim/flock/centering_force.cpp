@@ -1,7 +1,6 @@
 #include "sim/flock/centering_force.h"
 
-#include <tbb/parallel_for.h>
-
+#include "sim/flock/parallel_agents.h"
 #include "sim/flock/smooth_kernel.h"
 
 namespace kf {
@@ -12,8 +11,8 @@ void CenteringForce::prepare(const FlockState& s) {
     offset_.resize(s.x.size());
     b_.resize(p);
   }
-  tbb::parallel_for(tbb::blocked_range<int>(0, p, 256), [&](const tbb::blocked_range<int>& r) {
-    for (int i = r.begin(); i < r.end(); ++i) {
+  parallel_agents(p, [&](int i) {
+    {
       const Vec3 xi = seg(s.x, i);
       Vec3 a = Vec3::Zero();
       double b = 1.0;

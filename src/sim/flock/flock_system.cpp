@@ -1,7 +1,5 @@
 #include "sim/flock/flock_system.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -12,19 +10,11 @@
 #include "sim/flock/drag_force.h"
 #include "sim/flock/flock_spawn.h"
 #include "sim/flock/matching_force.h"
+#include "sim/flock/parallel_agents.h"
 #include "sim/flock/wander_force.h"
 #include "sim/make_system.h"
 
 namespace kf {
-
-namespace {
-template <class F>
-void parallel_agents(int p, F&& f) {
-  tbb::parallel_for(tbb::blocked_range<int>(0, p, 128), [&](const tbb::blocked_range<int>& r) {
-    for (int i = r.begin(); i < r.end(); ++i) f(i);
-  });
-}
-}  // namespace
 
 FlockSystem::FlockSystem(const FlockSpec& spec, double h, int steps, unsigned seed, double h_ref)
     : spec_(spec), h_(h), seed_(seed), masses_(VecX::Constant(spec.agents, spec.mass)) {

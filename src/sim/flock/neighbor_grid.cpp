@@ -1,9 +1,9 @@
 #include "sim/flock/neighbor_grid.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
+
+#include "sim/flock/parallel_agents.h"
 
 namespace kf {
 
@@ -22,13 +22,6 @@ uint64_t mix(uint64_t z) {
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
   return z ^ (z >> 31);
-}
-
-template <class F>
-void parallel_agents(int p, F&& f) {
-  tbb::parallel_for(tbb::blocked_range<int>(0, p, 256), [&](const tbb::blocked_range<int>& r) {
-    for (int i = r.begin(); i < r.end(); ++i) f(i);
-  });
 }
 
 }  // namespace
