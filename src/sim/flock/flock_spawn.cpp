@@ -1,0 +1,55 @@
+#include "sim/flock/flock_spawn.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <tuple>
+#include <vector>
+
+namespace kf {
+
+namespace {
+uint64_t mix(uint64_t z) {
+  z += 0x9E3779B97F4A7C15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+double unit(uint64_t h) { return double(h >> 11) / 9007199254740992.0; }  // [0, 1)
+}  // namespace
+
+VecX spawn_positions(const FlockSpec& spec, unsigned seed) {
+  const int p = spec.agents;
+  const double dmin = spec.min_spawn_distance(), R = spec.spawn.radius;
+  // Coarsest lattice whose points, shrunk in by the jitter, still number p.
+  double s = std::max(dmin, std::sqrt(M_PI * R * R / p)), jitter = 0;
+  for (;;) {
+    jitter = 0.5 * (s - dmin);
+    if (lattice_points_in_disc(s, R - jitter, p) >= p) break;
+    s *= 0.99;
+    if (s <= dmin) {
+      s = dmin;
+      jitter = 0;
+      break;
+    }
+  }
+  const double inner = R - jitter;
+  const long n = long(std::floor(std::max(inner, 0.0) / s));
+  std::vector<std::tuple<long, long, long>> points;  // (|lattice|^2, a, c)
+  for (long a = -n; a <= n; ++a)
+    for (long c = -n; c <= n; ++c)
+      if (double(a * a + c * c) * s * s <= inner * inner) points.emplace_back(a * a + c * c, a, c);
+  std::sort(points.begin(), points.end());
+
+  VecX x = VecX::Zero(3 * p);
+  for (int i = 0; i < p && i < int(points.size()); ++i) {
+    const auto [r2, a, c] = points[i];
+    const uint64_t h = mix(mix(uint64_t(seed) ^ 0x5F1A7E5EEDULL) ^ uint64_t(i));
+    const double angle = 2 * M_PI * unit(h), rho = jitter * std::sqrt(unit(mix(h)));
+    seg(x, i) = spec.spawn.center + Vec3(a * s + rho * std::cos(angle), 0.0, c * s + rho * std::sin(angle));
+    x[3 * i + 1] = 0.0;
+  }
+  return x;
+}
+
+}  // namespace kf

@@ -1,0 +1,20 @@
+#pragma once
+// The C1 weight shared by the neighbour forces: w(r) = (1 - r^2/R^2)^2 for r < R, else 0.
+// Value and slope both vanish at r = R, so forces and their Jacobians are continuous at the cut-off.
+
+namespace kf {
+
+struct KernelWeight {
+  double w = 0;       // weight, dimensionless, in [0, 1]
+  double dw_dr2 = 0;  // derivative with respect to r^2 (1/m^2); d w/d x_i = 2 dw_dr2 (x_i - x_j)
+};
+
+// r2: squared distance (m^2); radius: cut-off R (m).
+inline KernelWeight smooth_kernel(double r2, double radius) {
+  const double inv_r2 = 1.0 / (radius * radius);
+  const double t = 1.0 - r2 * inv_r2;
+  if (t <= 0) return {};
+  return {t * t, -2.0 * t * inv_r2};
+}
+
+}  // namespace kf

@@ -1,0 +1,49 @@
+// One flock step and one adjoint step at 200, 1,000 and 10,000 agents (default forces, ~1 m apart).
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+#include "sim/flock/flock_system.h"
+
+namespace {
+
+struct FlockFixture {
+  explicit FlockFixture(int agents) {
+    kf::FlockSpec spec;
+    spec.agents = agents;
+    spec.spawn.radius = std::sqrt(agents / M_PI) * 1.05;
+    spec.spawn.velocity = kf::Vec3(1, 0, 0);
+    sys = std::make_unique<kf::FlockSystem>(spec, 1.0 / 30, 100, 1);
+    sys->initial_state(x, v);
+    u = kf::VecX::Zero(x.size());
+    xhat1 = kf::VecX::Constant(x.size(), 0.1);
+    vhat1 = kf::VecX::Constant(x.size(), -0.2);
+    sys->step(0, x, v, u, x1, v1);  // first call sizes every buffer
+  }
+  std::unique_ptr<kf::FlockSystem> sys;
+  kf::VecX x, v, u, x1, v1, xhat1, vhat1, xhat, vhat, uhat;
+};
+
+void BM_FlockStep(benchmark::State& state) {
+  FlockFixture f(int(state.range(0)));
+  for (auto _ : state) {
+    f.sys->step(1, f.x, f.v, f.u, f.x1, f.v1);
+    benchmark::DoNotOptimize(f.x1.data());
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+
+void BM_FlockStepAdjoint(benchmark::State& state) {
+  FlockFixture f(int(state.range(0)));
+  f.sys->step_adjoint(1, f.x, f.v, f.u, f.xhat1, f.vhat1, f.xhat, f.vhat, f.uhat);
+  for (auto _ : state) {
+    f.sys->step_adjoint(1, f.x, f.v, f.u, f.xhat1, f.vhat1, f.xhat, f.vhat, f.uhat);
+    benchmark::DoNotOptimize(f.xhat.data());
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+
+}  // namespace
+
+BENCHMARK(BM_FlockStep)->Arg(200)->Arg(1000)->Arg(10000)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FlockStepAdjoint)->Arg(200)->Arg(1000)->Arg(10000)->Unit(benchmark::kMicrosecond);

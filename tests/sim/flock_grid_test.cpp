@@ -1,0 +1,64 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <vector>
+
+#include "sim/flock/neighbor_grid.h"
+
+namespace kf {
+namespace {
+
+std::vector<int> brute_force(const VecX& x, int i, double radius) {
+  std::vector<int> out;
+  for (int j = 0; j < int(x.size() / 3); ++j)
+    if (j != i && (seg(x, j) - seg(x, i)).squaredNorm() < radius * radius) out.push_back(j);
+  return out;
+}
+
+TEST(NeighborGrid, EqualsBruteForce) {
+  std::mt19937_64 rng(5);
+  NeighborGrid grid;  // reused across sizes, as the simulation does
+  long total = 0;
+  for (int p : {1, 2, 17, 300, 2000})
+    for (double box : {0.5, 5.0, 60.0})  // dense, natural, sparse
+      for (double radius : {0.7, 1.5}) {
+        std::uniform_real_distribution<double> u(-box, box);
+        VecX x = VecX::Zero(3 * p);
+        for (int i = 0; i < p; ++i) x[3 * i] = u(rng), x[3 * i + 2] = u(rng);
+        if (p > 3) {
+          seg(x, 1) = seg(x, 0);                                     // coincident
+          seg(x, 2) = seg(x, 0) + Vec3(radius * (1 - 1e-12), 0, 0);  // just inside
+          seg(x, 3) = seg(x, 0) - Vec3(0, 0, radius);                // exactly at the cut-off: excluded
+        }
+        grid.build(x, radius);
+        ASSERT_EQ(grid.agents(), p);
+        for (int i = 0; i < p; ++i) {
+          auto got = grid.neighbors(i);
+          std::vector<int> sorted(got.begin(), got.end());
+          std::sort(sorted.begin(), sorted.end());
+          const std::vector<int> want = brute_force(x, i, radius);
+          ASSERT_EQ(sorted, want) << "p " << p << " box " << box << " radius " << radius << " agent " << i;
+          total += long(want.size());
+        }
+      }
+  EXPECT_GT(total, 10000) << "the configurations must actually have neighbours";
+}
+
+TEST(NeighborGrid, FarApartAndNegativeCoordinates) {
+  // Cells with huge and negative indices hash into the same small table without mixing up.
+  VecX x = VecX::Zero(3 * 4);
+  seg(x, 0) = Vec3(-1e7, 0, -1e7);
+  seg(x, 1) = Vec3(-1e7 + 0.5, 0, -1e7);
+  seg(x, 2) = Vec3(1e7, 0, 1e7);
+  seg(x, 3) = Vec3(-0.1, 0, 0.1);
+  NeighborGrid grid;
+  grid.build(x, 1.0);
+  EXPECT_EQ(std::vector<int>(grid.neighbors(0).begin(), grid.neighbors(0).end()), std::vector<int>{1});
+  EXPECT_EQ(std::vector<int>(grid.neighbors(1).begin(), grid.neighbors(1).end()), std::vector<int>{0});
+  EXPECT_TRUE(grid.neighbors(2).empty());
+  EXPECT_TRUE(grid.neighbors(3).empty());
+}
+
+}  // namespace
+}  // namespace kf
