@@ -39,7 +39,12 @@ Vec3 BlockSparse3::row_times(int i, const VecX& x) const {
 }
 
 void BlockSparse3::multiply(const VecX& x, VecX& y) const {
-  tbb::parallel_for(tbb::blocked_range<int>(0, block_rows(), 256), [&](const tbb::blocked_range<int>& r) {
+  constexpr int kGrain = 256;
+  if (block_rows() <= kGrain) {  // a task costs more than a small product
+    for (int i = 0; i < block_rows(); ++i) seg(y, i) = row_times(i, x);
+    return;
+  }
+  tbb::parallel_for(tbb::blocked_range<int>(0, block_rows(), kGrain), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i) seg(y, i) = row_times(i, x);
   });
 }

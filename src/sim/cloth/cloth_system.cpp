@@ -198,10 +198,26 @@ void ClothSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& 
   xhat.resize(3 * p_);
   vhat.resize(3 * p_);
   uhat.resize(3 * p_);
-  // K and A are symmetric (see header), so K^T w = K w.
+  // xhat needs K^T w with the exact force derivative (the definite K of A and the missing damping term
+  // would bias every step by O(h), which does not vanish as h falls). Per spring G = d f_a / d x_b
+  // (elastic + damping): (K^T w)_a = G^T (w_b - w_a), (K^T w)_b = -(that).
+  const int ns = int(springs_.size());
+  tbb::parallel_for(tbb::blocked_range<int>(0, ns, kSpringGrain), [&](const tbb::blocked_range<int>& r) {
+    for (int k = r.begin(); k < r.end(); ++k) {
+      const BucklingSpring& s = springs_[k];
+      Mat3 G = spring_jacobian(s, x, /*definite=*/false);
+      if (k < damped_) G += damping_jacobian_x(s, spec_.damping, x, v);
+      spring_f_[k] = G.transpose() * (seg(w, s.b) - seg(w, s.a));
+    }
+  });
   tbb::parallel_for(tbb::blocked_range<int>(0, p_, kParticleGrain), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i) {
-      const Vec3 kw = K_.row_times(i, w);
+      Vec3 kw = Vec3::Zero();
+      for (int e = incident_start_[i]; e < incident_start_[i + 1]; ++e)
+        kw += incident_[e].sign * spring_f_[incident_[e].spring];
+      ContactForce c;
+      for (const auto& col : colliders_)
+        if (col->contact(n, seg(x, i), seg(v, i), /*definite=*/false, c)) kw += c.dfdx.transpose() * seg(w, i);
       if (free_[i]) {
         seg(xhat, i) = seg(xhat1, i) + h * kw;
         seg(vhat, i) = mass_[i] * seg(w, i);

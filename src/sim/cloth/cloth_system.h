@@ -4,10 +4,12 @@
 // Forward:  A dv = b, A = M - h D - h^2 K, b = h (f + h K v + u), solved by block-Jacobi PCG with pinned
 //           particles filtered out (Baraff-Witkin); v1 = v + dv, x1 = x + h v1.
 // Backward: A^T w = vhat1 + h xhat1 on the free set, vhat = M w, xhat = xhat1 + h K^T w, uhat = h w.
-// K holds the springs' (definite) stiffness and the colliders' normal stiffness; D the spring damping and
-// air drag. The non-symmetric position derivative of spring damping is left out of K in both passes, so A
-// and K are symmetric and the backward solve reuses the forward machinery. A is recomputed at (x_n, v_n)
-// in the backward pass rather than stored.
+// In A (both passes) K is the springs' definite stiffness (compressive transverse part dropped) plus the
+// colliders' normal stiffness, D the spring damping and air drag; the non-symmetric position derivative
+// of spring damping is left out of A in both passes, so A is symmetric and the backward solve reuses the
+// forward PCG. The K^T w of xhat is not a solve: it uses the exact df/dx (springs, damping, collider
+// curvature), since any bias there is O(h) per step and would not shrink as h falls.
+// A is recomputed at (x_n, v_n) in the backward pass rather than stored.
 // A pinned particle is moved to its PinTrack position at n+1 whatever its state, so no adjoint flows
 // through its own x, v (vhat = 0 there); only its coupling to free neighbours reaches xhat.
 #include <memory>
