@@ -95,6 +95,7 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   dv_.setZero(3 * p_);
   kv_.setZero(3 * p_);
   aw_.setZero(3 * p_);
+  w_.setZero(3 * p_);
   pcg_.resize(p_);
 }
 
@@ -177,7 +178,9 @@ bool ClothSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
     pins_->state(n + 1, i, seg(x0_, i), pos, vel);
     seg(dv_, i) = (pos - seg(x, i)) / h - seg(v, i);
   }
-  const PcgResult res = pcg_.solve(A_, free_, rhs_, dv_, spec_.cg_tolerance, spec_.cg_max_iterations);
+  const bool warm = n == last_forward_n_ + 1;
+  const PcgResult res = pcg_.solve(A_, free_, rhs_, dv_, spec_.cg_tolerance, spec_.cg_max_iterations, warm);
+  last_forward_n_ = res.converged ? n : -2;
   last_cg_ = res.iterations;
   v_next.resize(3 * p_);
   x_next.resize(3 * p_);
@@ -191,10 +194,12 @@ void ClothSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& 
   assemble(n, x, v);
   const double h = h_;
   rhs_ = vhat1 + h * xhat1;
-  dv_.setZero();  // w: zero on pinned particles
-  const PcgResult res = pcg_.solve(A_, free_, rhs_, dv_, spec_.cg_tolerance, spec_.cg_max_iterations);
+  // w is zero on pinned particles.
+  const bool warm = n == last_adjoint_n_ - 1;
+  const PcgResult res = pcg_.solve(A_, free_, rhs_, w_, spec_.cg_tolerance, spec_.cg_max_iterations, warm);
+  last_adjoint_n_ = res.converged ? n : -2;
   last_adjoint_cg_ = res.iterations;
-  const VecX& w = dv_;
+  const VecX& w = w_;
   xhat.resize(3 * p_);
   vhat.resize(3 * p_);
   uhat.resize(3 * p_);

@@ -10,6 +10,8 @@
 // forward PCG. The K^T w of xhat is not a solve: it uses the exact df/dx (springs, damping, collider
 // curvature), since any bias there is O(h) per step and would not shrink as h falls.
 // A is recomputed at (x_n, v_n) in the backward pass rather than stored.
+// PCG starts from the previous step's solution when steps come in sequence (n after n-1 forward, n after
+// n+1 backward) and from zero otherwise, so a rollout is the same function of its inputs on every run.
 // A pinned particle is moved to its PinTrack position at n+1 whatever its state, so no adjoint flows
 // through its own x, v (vhat = 0 there); only its coupling to free neighbours reaches xhat.
 #include <memory>
@@ -83,6 +85,8 @@ class ClothSystem final : public System {
   VecX force_, rhs_, dv_, kv_, aw_;
   FilteredPcg pcg_;
   int last_cg_ = 0, last_adjoint_cg_ = 0;
+  VecX w_;                                       // last adjoint solution (warm start)
+  int last_forward_n_ = -2, last_adjoint_n_ = -2;  // steps of the last solves, -2: none
 };
 
 }  // namespace kf

@@ -32,10 +32,11 @@ void FilteredPcg::precondition(const std::vector<char>& free, const VecX& r, Vec
 }
 
 PcgResult FilteredPcg::solve(const BlockSparse3& A, const std::vector<char>& free, const VecX& b, VecX& x,
-                             double tol, int max_iterations) {
+                             double tol, int max_iterations, bool warm) {
   PcgResult res;
-  for (int i = 0; i < int(free.size()); ++i)
-    if (free[i]) seg(x, i).setZero();
+  if (!warm)
+    for (int i = 0; i < int(free.size()); ++i)
+      if (free[i]) seg(x, i).setZero();
   A.multiply(x, q_);
   r_ = b - q_;
   filter(free, r_);

@@ -23,9 +23,10 @@ class FilteredPcg {
   // Inverts the diagonal blocks of A on free particles. Call after A changes, before solve.
   void prepare(const BlockSparse3& A, const std::vector<char>& free);
   // A: symmetric positive definite on the free set. b, x: 3p. On entry x holds the prescribed values on
-  // constrained particles (free entries are ignored and start at zero). Stops at |r| <= tol |S b|.
+  // constrained particles and, when `warm` is true, the initial guess on free ones (otherwise they start
+  // at zero). Stops at |r| <= tol |S b|.
   PcgResult solve(const BlockSparse3& A, const std::vector<char>& free, const VecX& b, VecX& x, double tol,
-                  int max_iterations);
+                  int max_iterations, bool warm = false);
 
  private:
   void filter(const std::vector<char>& free, VecX& y) const;
