@@ -1,13 +1,98 @@
 #include "scene/cloth_spec.h"
 
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
 #include "scene/params.h"
 
 namespace kf {
+
+namespace {
+
+const std::vector<std::string> kPinSets = {"none",        "top_edge",    "bottom_edge",    "left_edge",
+                                           "right_edge",  "top_corners", "bottom_corners", "corners"};
+
+Vec3 unit_vec3(Block& b, const std::string& key, const Vec3& def) {
+  Vec3 a = b.vec3(key, def, -1e3, 1e3);
+  if (a.norm() < 1e-9) b.fail(key, "expected a non-zero direction");
+  return a.normalized();
+}
+
+ColliderSpec parse_collider(Block b) {
+  ColliderSpec c;
+  c.type = b.string("type", {"ground", "sphere", "torus"});
+  c.center = b.vec3("center", c.center);
+  if (c.type == "ground" || c.type == "torus") c.axis = unit_vec3(b, "axis", c.axis);
+  if (c.type == "sphere" || c.type == "torus") c.radius = b.number("radius", c.radius, 1e-4, 1e4);
+  if (c.type == "torus") {
+    c.tube_radius = b.number("tube_radius", c.tube_radius, 1e-5, 1e4);
+    if (c.tube_radius >= c.radius) b.fail("tube_radius", "expected less than \"radius\" (a ring, not a spindle torus)");
+  }
+  c.thickness = b.number("thickness", c.thickness, 1e-6, 10.0);
+  c.stiffness = b.number("stiffness", c.stiffness, 0.0, 1e9);
+  b.finish();
+  return c;
+}
+
+}  // namespace
+
+std::vector<int> named_pin_set(const std::string& name, int nx, int ny) {
+  std::vector<int> out;
+  auto idx = [nx](int i, int j) { return j * nx + i; };
+  if (name == "none") {
+  } else if (name == "top_edge") {
+    for (int i = 0; i < nx; ++i) out.push_back(idx(i, ny - 1));
+  } else if (name == "bottom_edge") {
+    for (int i = 0; i < nx; ++i) out.push_back(idx(i, 0));
+  } else if (name == "left_edge") {
+    for (int j = 0; j < ny; ++j) out.push_back(idx(0, j));
+  } else if (name == "right_edge") {
+    for (int j = 0; j < ny; ++j) out.push_back(idx(nx - 1, j));
+  } else if (name == "top_corners") {
+    out = {idx(0, ny - 1), idx(nx - 1, ny - 1)};
+  } else if (name == "bottom_corners") {
+    out = {idx(0, 0), idx(nx - 1, 0)};
+  } else if (name == "corners") {
+    out = {idx(0, 0), idx(nx - 1, 0), idx(0, ny - 1), idx(nx - 1, ny - 1)};
+  } else {
+    throw std::invalid_argument("unknown pin set \"" + name + "\"");
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
 
 ClothSpec parse_cloth_spec(Block& b) {
   ClothSpec s;
   s.nx = b.integer("nx", s.nx, 2, 1024);
   s.ny = b.integer("ny", s.ny, 2, 1024);
+  s.width = b.number("width", s.width, 1e-4, 1e4);
+  s.height = b.number("height", s.height, 1e-4, 1e4);
+  s.origin = b.vec3("origin", s.origin);
+  s.u_axis = unit_vec3(b, "u_axis", s.u_axis);
+  s.v_axis = unit_vec3(b, "v_axis", s.v_axis);
+  if (std::abs(s.u_axis.dot(s.v_axis)) > 1e-6) b.fail("v_axis", "expected a direction perpendicular to \"u_axis\"");
+  s.mass = b.number("mass", s.mass, 1e-9, 1e6);
+  const int p = s.particles();
+  if (b.has("pins") && b.json().at("pins").is_string()) {
+    s.pins = named_pin_set(b.string("pins", "none", kPinSets), s.nx, s.ny);
+  } else if (b.has("pins")) {
+    s.pins = b.integers("pins", 0, 0, p - 1);
+    std::sort(s.pins.begin(), s.pins.end());
+    s.pins.erase(std::unique(s.pins.begin(), s.pins.end()), s.pins.end());
+  }
+  s.stretch = b.number("stretch", s.stretch, 0.0, 1e9);
+  s.shear = b.number("shear", s.shear, 0.0, 1e9);
+  s.bend = b.number("bend", s.bend, 0.0, 1e9);
+  s.buckle_strain = b.number("buckle_strain", s.buckle_strain, 1e-6, 1.0);
+  s.buckle_stiffness = b.number("buckle_stiffness", s.buckle_stiffness, 0.0, 1.0);
+  s.damping = b.number("damping", s.damping, 0.0, 1e6);
+  s.air_drag = b.number("air_drag", s.air_drag, 0.0, 1e6);
+  s.gravity = b.vec3("gravity", s.gravity, -1e4, 1e4);
+  s.velocity = b.vec3("velocity", s.velocity, -1e4, 1e4);
+  s.cg_tolerance = b.number("cg_tolerance", s.cg_tolerance, 1e-16, 1e-1);
+  s.cg_max_iterations = b.integer("cg_max_iterations", s.cg_max_iterations, 1, 1'000'000);
+  for (Block& c : b.array("colliders")) s.colliders.push_back(parse_collider(std::move(c)));
   b.finish();
   return s;
 }

@@ -1,6 +1,8 @@
 #pragma once
 // A rectangular cloth and its colliders as the scene file states them.
-// Particle (i, j), i = 0..nx-1 along the width, j = 0..ny-1 along the height, has index j*nx + i.
+// Particle (i, j), i = 0..nx-1 along the width (u_axis), j = 0..ny-1 along the height (v_axis), has
+// index j*nx + i. Named edges are by index: "bottom" is j = 0, "top" is j = ny-1, "left" is i = 0,
+// "right" is i = nx-1 (so with v_axis = +Y the top edge is the highest row).
 #include <string>
 #include <vector>
 
@@ -22,9 +24,36 @@ struct ColliderSpec {
 
 struct ClothSpec {
   int nx = 16, ny = 16;
+  double width = 1.0, height = 1.0;     // metres, along u_axis and v_axis
+  Vec3 origin = Vec3::Zero();           // position of particle (0, 0), metres
+  Vec3 u_axis = Vec3::UnitX();          // unit direction of the width edge (i grows)
+  Vec3 v_axis = Vec3::UnitY();          // unit direction of the height edge (j grows)
+  double mass = 0.5;                    // total, kg, spread evenly over the particles
+  std::vector<int> pins;                // pinned particle indices (sorted, unique; named sets expanded)
+  double stretch = 500.0;               // structural (type-1) spring stiffness in tension, N/m
+  double shear = 50.0;                  // diagonal (type-1) spring stiffness in tension, N/m
+  double bend = 5.0;                    // bending (type-2, two edges) spring stiffness in tension, N/m
+  double buckle_strain = 0.005;         // compressive strain at which a spring buckles (Choi-Ko onset)
+  double buckle_stiffness = 0.1;        // post-buckling stiffness as a fraction of the tension stiffness
+  double damping = 0.05;                // spring damping along structural and shear springs, N s/m
+  double air_drag = 0.1;                // linear drag per unit mass, 1/s (f = -air_drag * m * v)
+  Vec3 gravity = Vec3(0, -9.81, 0);     // m/s^2
+  Vec3 velocity = Vec3::Zero();         // initial velocity of every free particle, m/s
+  double cg_tolerance = 1e-8;           // PCG stops when |r| <= cg_tolerance * |b| (filtered)
+  int cg_max_iterations = 1000;         // PCG failing to converge within this fails the step
   std::vector<ColliderSpec> colliders;
+
+  int particles() const { return nx * ny; }
+  int index(int i, int j) const { return j * nx + i; }
 };
 
+// Reads the "cloth" block (every key range-checked, unknown keys are errors). "pins" is either an array
+// of particle indices or one named set: "none", "top_edge", "bottom_edge", "left_edge", "right_edge",
+// "top_corners", "bottom_corners", "corners".
 ClothSpec parse_cloth_spec(Block& b);
+
+// The particle indices of a named pin set for an nx x ny cloth (sorted). Throws std::invalid_argument on
+// an unknown name.
+std::vector<int> named_pin_set(const std::string& name, int nx, int ny);
 
 }  // namespace kf

@@ -1,0 +1,36 @@
+#pragma once
+// Choi & Ko (2002) springs: linear in tension, a buckling response in compression.
+//
+// A spring between particles a and b with rest length L carries a tension T(s) along d = x_b - x_a,
+// s = |d|: the force on a is T d/s, on b its opposite. In tension (s >= L) T = k (s - L). In compression a
+// cloth strip does not resist like a rod: it buckles. After Choi & Ko the compressive force rises to about
+// the Euler buckling load F_b and then grows only slowly (post-buckling stiffness k_p):
+//     T(s) = -( F_b (1 - exp(-(k - k_p) e / F_b)) + k_p e ),   e = L - s > 0,
+// which is C1 at s = L (slope k on both sides) so finite differences and the optimiser see no kink.
+// Type-1 springs (structural, shear) and type-2 springs (bending: across two edges) share this law with
+// their own k; F_b = k L buckle_strain and k_p = buckle_stiffness k.
+#include "core/types.h"
+
+namespace kf {
+
+struct BucklingSpring {
+  int a = 0, b = 0;          // particle indices
+  double rest = 1.0;         // L, metres
+  double k = 0.0;            // tension stiffness, N/m
+  double k_post = 0.0;       // post-buckling stiffness k_p <= k, N/m
+  double f_buckle = 0.0;     // buckling load F_b > 0, N (0: linear in compression too)
+};
+
+// Tension T (N, positive pulls the ends together) and its slope dT/ds (N/m, always >= 0) at length s.
+void spring_tension(const BucklingSpring& sp, double s, double& T, double& dT_ds);
+
+// Force on particle a (N); the force on b is its negative. x: 3p positions, metres.
+Vec3 spring_force(const BucklingSpring& sp, const VecX& x);
+
+// B = d(force on a)/d(x_b) (3x3, N/m). The spring's 6x6 stiffness is [[-B, B], [B, -B]] (B symmetric).
+// `definite` drops the compressive part of the transverse term (T < 0), which keeps -K positive
+// semi-definite so the implicit matrix stays SPD; the exact Jacobian is definite = false.
+// Springs shorter than 1e-9 L have no direction: force 0 and B = dT/ds I (finite, never NaN).
+Mat3 spring_jacobian(const BucklingSpring& sp, const VecX& x, bool definite);
+
+}  // namespace kf

@@ -1,0 +1,186 @@
+// Cloth force terms: values and Jacobians against central finite differences.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <random>
+
+#include "sim/cloth/air_drag.h"
+#include "sim/cloth/buckling_spring.h"
+#include "sim/cloth/spring_damping.h"
+
+namespace kf {
+namespace {
+
+// Largest per-component error of `a` against `fd`, relative to max(|fd_ij|, 1e-6 max|fd|).
+double relative_error(const Mat3& a, const Mat3& fd) {
+  const double floor = 1e-6 * fd.cwiseAbs().maxCoeff();
+  return ((a - fd).cwiseAbs().array() / fd.cwiseAbs().array().max(floor)).maxCoeff();
+}
+
+// d(force on a)/d(x_b) by central differences of `force(x)`.
+template <class F>
+Mat3 fd_jacobian(F force, VecX x, int particle, double eps) {
+  Mat3 J;
+  for (int k = 0; k < 3; ++k) {
+    const double x0 = x[3 * particle + k];
+    x[3 * particle + k] = x0 + eps;
+    const Vec3 fp = force(x);
+    x[3 * particle + k] = x0 - eps;
+    const Vec3 fm = force(x);
+    x[3 * particle + k] = x0;
+    J.col(k) = (fp - fm) / (2 * eps);
+  }
+  return J;
+}
+
+BucklingSpring test_spring() {
+  BucklingSpring s;
+  s.a = 0;
+  s.b = 1;
+  s.rest = 0.1;
+  s.k = 400;
+  s.k_post = 40;
+  s.f_buckle = 400 * 0.1 * 0.005;
+  return s;
+}
+
+// Two particles: a at a random point, b at `ratio` * rest along a random direction.
+VecX pair_at(double ratio, double rest, std::mt19937& rng) {
+  std::normal_distribution<double> N;
+  VecX x(6);
+  const Vec3 a(N(rng), N(rng), N(rng));
+  const Vec3 dir = Vec3(N(rng), N(rng), N(rng)).normalized();
+  seg(x, 0) = a;
+  seg(x, 1) = a + ratio * rest * dir;
+  return x;
+}
+
+TEST(ClothSpring, TensionIsC1AndMatchesItsSlope) {
+  const BucklingSpring s = test_spring();
+  double T, dT, Tp, dTp, Tm, dTm;
+  spring_tension(s, s.rest * 1.1, T, dT);
+  EXPECT_NEAR(T, s.k * 0.1 * s.rest, 1e-12);
+  // Slope continuous at the rest length (no kink for the optimiser).
+  spring_tension(s, s.rest * (1 + 1e-12), Tp, dTp);
+  spring_tension(s, s.rest * (1 - 1e-12), Tm, dTm);
+  EXPECT_NEAR(dTp, dTm, 1e-6 * s.k);
+  // Deep compression: force near the buckling load, stiffness near the post-buckling stiffness.
+  spring_tension(s, s.rest * 0.5, T, dT);
+  EXPECT_LT(T, -s.f_buckle);
+  EXPECT_NEAR(dT, s.k_post, 1e-6 * s.k);
+  for (double ratio : {1.3, 1.0001, 0.9999, 0.998, 0.95, 0.6, 0.05}) {
+    const double L = s.rest * ratio, eps = 1e-8;
+    spring_tension(s, L, T, dT);
+    spring_tension(s, L + eps, Tp, dTp);
+    spring_tension(s, L - eps, Tm, dTm);
+    ASSERT_GT(std::abs(dT), 0);
+    EXPECT_NEAR(dT, (Tp - Tm) / (2 * eps), 1e-6 * s.k) << "ratio " << ratio;
+    EXPECT_GE(dT, 0);
+  }
+}
+
+TEST(ClothSpring, JacobianMatchesFiniteDifferencesInTensionAndCompression) {
+  const BucklingSpring s = test_spring();
+  std::mt19937 rng(7);
+  for (double ratio : {1.25, 1.01, 0.999, 0.99, 0.9, 0.5, 0.1, 1e-3}) {
+    for (int trial = 0; trial < 4; ++trial) {
+      const VecX x = pair_at(ratio, s.rest, rng);
+      const double eps = 1e-6 * ratio * s.rest;
+      auto force = [&](const VecX& y) { return spring_force(s, y); };
+      const Mat3 B = spring_jacobian(s, x, /*definite=*/false);
+      const Mat3 fd_b = fd_jacobian(force, x, 1, eps);
+      const Mat3 fd_a = fd_jacobian(force, x, 0, eps);
+      ASSERT_GT(fd_b.norm(), 0) << "ratio " << ratio;
+      EXPECT_LT(relative_error(B, fd_b), 1e-5) << "ratio " << ratio << "\nB=\n" << B << "\nfd=\n" << fd_b;
+      EXPECT_LT(relative_error(-B, fd_a), 1e-5) << "ratio " << ratio;
+      EXPECT_LT((B - B.transpose()).norm(), 1e-12 * B.norm());
+    }
+  }
+}
+
+TEST(ClothSpring, DefiniteJacobianIsPositiveSemidefinite) {
+  const BucklingSpring s = test_spring();
+  std::mt19937 rng(3);
+  for (double ratio : {1.2, 0.9, 0.3}) {
+    const VecX x = pair_at(ratio, s.rest, rng);
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(spring_jacobian(s, x, true));
+    EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-12) << "ratio " << ratio;
+    Eigen::SelfAdjointEigenSolver<Mat3> exact(spring_jacobian(s, x, false));
+    if (ratio < 1) EXPECT_LT(exact.eigenvalues().minCoeff(), 0);  // what the definite form removes
+  }
+}
+
+TEST(ClothSpring, ZeroLengthAndNearlyDegenerateSpringsStayFinite) {
+  const BucklingSpring s = test_spring();
+  VecX x = VecX::Zero(6);
+  x << 0.3, 0.2, 0.1, 0.3, 0.2, 0.1;  // zero length
+  VecX v = VecX::Ones(6);
+  EXPECT_TRUE(spring_force(s, x).allFinite());
+  EXPECT_TRUE(spring_jacobian(s, x, false).allFinite());
+  EXPECT_TRUE(spring_jacobian(s, x, true).allFinite());
+  EXPECT_TRUE(damping_force(s, 0.1, x, v).allFinite());
+  EXPECT_TRUE(damping_jacobian_x(s, 0.1, x, v).allFinite());
+  EXPECT_TRUE(damping_jacobian_v(s, 0.1, x).allFinite());
+  for (double len : {1e-300, 1e-20, 1e-11, 1e-9}) {
+    x[3] = 0.3 + len;
+    EXPECT_TRUE(spring_force(s, x).allFinite()) << len;
+    EXPECT_TRUE(spring_jacobian(s, x, false).allFinite()) << len;
+    EXPECT_TRUE(damping_jacobian_x(s, 0.1, x, v).allFinite()) << len;
+  }
+}
+
+TEST(ClothDamping, JacobiansMatchFiniteDifferences) {
+  const BucklingSpring s = test_spring();
+  const double c = 0.3;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> N;
+  for (double ratio : {1.2, 0.8, 0.05}) {
+    for (int trial = 0; trial < 4; ++trial) {
+      const VecX x = pair_at(ratio, s.rest, rng);
+      VecX v(6);
+      for (int k = 0; k < 6; ++k) v[k] = N(rng);
+      const double eps = 1e-4 * ratio * s.rest;
+      const Mat3 Jx = damping_jacobian_x(s, c, x, v);
+      const Mat3 fdx = fd_jacobian([&](const VecX& y) { return damping_force(s, c, y, v); }, x, 1, eps);
+      ASSERT_GT(fdx.norm(), 0);
+      EXPECT_LT(relative_error(Jx, fdx), 1e-5) << "ratio " << ratio;
+      const Mat3 Jv = damping_jacobian_v(s, c, x);
+      const Mat3 fdv = fd_jacobian([&](const VecX& w) { return damping_force(s, c, x, w); }, v, 1, 1e-4);
+      const Mat3 fdv_a = fd_jacobian([&](const VecX& w) { return damping_force(s, c, x, w); }, v, 0, 1e-4);
+      ASSERT_GT(fdv.norm(), 0);
+      EXPECT_LT(relative_error(Jv, fdv), 1e-7);
+      EXPECT_LT(relative_error(-Jv, fdv_a), 1e-7);
+    }
+  }
+}
+
+TEST(ClothDamping, RigidMotionIsNotDamped) {
+  const BucklingSpring s = test_spring();
+  std::mt19937 rng(5);
+  const VecX x = pair_at(1.1, s.rest, rng);
+  VecX v(6);
+  v << 1, 2, 3, 1, 2, 3;  // translation
+  EXPECT_LT(damping_force(s, 0.5, x, v).norm(), 1e-14);
+  const Vec3 w(0.3, -0.2, 0.7), d = seg(x, 1) - seg(x, 0);  // rotation about a
+  seg(v, 0).setZero();
+  seg(v, 1) = w.cross(d);
+  EXPECT_LT(damping_force(s, 0.5, x, v).norm(), 1e-14);
+}
+
+TEST(ClothAirDrag, JacobianMatchesFiniteDifferences) {
+  const double c = 0.7, m = 0.02;
+  const Vec3 v(0.3, -1.0, 2.0);
+  Mat3 fd;
+  for (int k = 0; k < 3; ++k) {
+    Vec3 vp = v, vm = v;
+    vp[k] += 1e-5;
+    vm[k] -= 1e-5;
+    fd.col(k) = (air_drag_force(c, m, vp) - air_drag_force(c, m, vm)) / 2e-5;
+  }
+  ASSERT_GT(fd.norm(), 0);
+  EXPECT_LT(relative_error(air_drag_jacobian_v(c, m), fd), 1e-8);
+}
+
+}  // namespace
+}  // namespace kf

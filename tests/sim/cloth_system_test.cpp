@@ -1,0 +1,183 @@
+// The cloth system as a whole: assembly, conservation, rest, pins, determinism.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <tbb/global_control.h>
+
+#include "adjoint/rollout.h"
+#include "scene/scene.h"
+#include "sim/cloth/cloth_system.h"
+
+namespace kf {
+namespace {
+
+ClothSpec spec_from(const std::string& cloth) {
+  return *parse_scene(R"({"cloth": )" + cloth + "}", "c.json").cloth;
+}
+
+double kinetic_energy(const ClothSystem& s, const VecX& v) {
+  double e = 0;
+  for (int i = 0; i < s.particles(); ++i) e += 0.5 * s.masses()[i] * seg(v, i).squaredNorm();
+  return e;
+}
+
+Vec3 momentum(const ClothSystem& s, const VecX& v) {
+  Vec3 p = Vec3::Zero();
+  for (int i = 0; i < s.particles(); ++i) p += s.masses()[i] * seg(v, i);
+  return p;
+}
+
+TEST(ClothSystem, AssembledMatricesMatchFiniteDifferencesOfTheForce) {
+  // All springs stretched, so the definite stiffness is the exact one.
+  ClothSystem sys(spec_from(R"({"nx": 5, "ny": 4, "damping": 0.3, "air_drag": 0.5, "pins": [3]})"), 0.01);
+  VecX x, v;
+  sys.initial_state(x, v);
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> U(-1, 1);
+  x *= 1.05;
+  for (int k = 0; k < x.size(); ++k) x[k] += 0.002 * U(rng);
+  for (int k = 0; k < v.size(); ++k) v[k] = U(rng);
+  sys.assemble(0, x, v);
+  const MatX K = MatX(sys.stiffness_matrix()), D = MatX(sys.damping_matrix()), A = MatX(sys.system_matrix());
+  // The damping's position derivative is left out of K by design; check K at v = 0 where it vanishes.
+  const VecX v0 = VecX::Zero(v.size());
+  MatX fdK(x.size(), x.size()), fdD(x.size(), x.size());
+  const double eps = 1e-6;
+  for (int k = 0; k < x.size(); ++k) {
+    VecX xp = x, xm = x, vp = v, vm = v;
+    xp[k] += eps;
+    xm[k] -= eps;
+    vp[k] += eps;
+    vm[k] -= eps;
+    sys.assemble(0, xp, v0);
+    VecX fp = sys.force();
+    sys.assemble(0, xm, v0);
+    fdK.col(k) = (fp - sys.force()) / (2 * eps);
+    sys.assemble(0, x, vp);
+    fp = sys.force();
+    sys.assemble(0, x, vm);
+    fdD.col(k) = (fp - sys.force()) / (2 * eps);
+  }
+  ASSERT_GT(fdK.norm(), 0);
+  ASSERT_GT(fdD.norm(), 0);
+  EXPECT_LT((K - fdK).cwiseAbs().maxCoeff(), 1e-6 * fdK.cwiseAbs().maxCoeff());
+  EXPECT_LT((D - fdD).cwiseAbs().maxCoeff(), 1e-6 * fdD.cwiseAbs().maxCoeff());
+  EXPECT_EQ((K - K.transpose()).cwiseAbs().maxCoeff(), 0);
+  // Exact up to the rounding of vectorised block arithmetic.
+  EXPECT_LE((A - A.transpose()).cwiseAbs().maxCoeff(), 1e-15 * A.cwiseAbs().maxCoeff());
+  MatX expectA = -0.01 * D - 1e-4 * K;
+  for (int k = 0; k < x.size(); ++k) expectA(k, k) += sys.masses()[k / 3];
+  EXPECT_LT((A - expectA).cwiseAbs().maxCoeff(), 1e-12 * A.cwiseAbs().maxCoeff());
+}
+
+TEST(ClothSystem, FreeClothWithoutDampingKeepsItsMomentum) {
+  ClothSystem sys(spec_from(R"({"nx": 8, "ny": 8, "gravity": [0, 0, 0], "damping": 0, "air_drag": 0,
+                                 "cg_tolerance": 1e-12})"),
+                  1.0 / 60);
+  VecX x, v, x1, v1;
+  sys.initial_state(x, v);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (int k = 0; k < v.size(); ++k) {
+    v[k] = U(rng);
+    x[k] += 0.01 * U(rng);  // start deformed, some springs compressed
+  }
+  const Vec3 p0 = momentum(sys, v);
+  const VecX u = VecX::Zero(x.size());
+  double scale = 0;
+  for (int i = 0; i < sys.particles(); ++i) scale += sys.masses()[i] * seg(v, i).norm();
+  for (int n = 0; n < 60; ++n) {
+    ASSERT_TRUE(sys.step(n, x, v, u, x1, v1)) << "step " << n;
+    x.swap(x1);
+    v.swap(v1);
+  }
+  const Vec3 p1 = momentum(sys, v);
+  ASSERT_GT(p0.norm(), 0);
+  EXPECT_LT((p1 - p0).norm(), 1e-9 * scale) << p0.transpose() << " -> " << p1.transpose();
+}
+
+TEST(ClothSystem, HangingDampedClothComesToRestWithPinsInPlace) {
+  ClothSystem sys(spec_from(R"({"nx": 12, "ny": 12, "pins": "top_edge", "damping": 0.5, "air_drag": 2.0})"),
+                  1.0 / 60);
+  VecX x, v, x1, v1, xstart;
+  sys.initial_state(x, v);
+  xstart = x;
+  // Start swinging: the cloth is pushed sideways out of its plane.
+  for (int i = 0; i < sys.particles(); ++i)
+    if (!sys.pinned(i)) seg(v, i) = Vec3(0, 0, 1.5);
+  const VecX u = VecX::Zero(x.size());
+  double ke_max = kinetic_energy(sys, v);
+  for (int n = 0; n < 600; ++n) {
+    ASSERT_TRUE(sys.step(n, x, v, u, x1, v1)) << "step " << n;
+    x.swap(x1);
+    v.swap(v1);
+    ke_max = std::max(ke_max, kinetic_energy(sys, v));
+  }
+  const double ke = kinetic_energy(sys, v);
+  ASSERT_GT(ke_max, 0);
+  EXPECT_LT(ke, 1e-6 * ke_max) << "kinetic energy " << ke << " of peak " << ke_max;
+  for (int i = 0; i < sys.particles(); ++i)
+    if (sys.pinned(i)) {
+      EXPECT_EQ(seg(x, i), seg(xstart, i));
+      EXPECT_EQ(seg(v, i), Vec3::Zero());
+    }
+  // It hangs below its pins.
+  EXPECT_LT(seg(x, 0).y(), seg(xstart, 0).y());
+}
+
+TEST(ClothSystem, ClothStaysOutsideASphereAndAboveTheGround) {
+  ClothSystem sys(spec_from(R"({"nx": 10, "ny": 10, "origin": [-0.5, 0.6, 0.5], "v_axis": [0, 0, -1],
+      "colliders": [{"type": "sphere", "center": [0, 0.3, 0], "radius": 0.25, "stiffness": 2e3},
+                    {"type": "ground", "stiffness": 2e3}]})"),
+                  1.0 / 60);
+  VecX x, v, x1, v1;
+  sys.initial_state(x, v);
+  const VecX u = VecX::Zero(x.size());
+  for (int n = 0; n < 90; ++n) {
+    ASSERT_TRUE(sys.step(n, x, v, u, x1, v1)) << "step " << n;
+    x.swap(x1);
+    v.swap(v1);
+  }
+  double min_sphere = 1e9, min_ground = 1e9;
+  for (int i = 0; i < sys.particles(); ++i) {
+    min_sphere = std::min(min_sphere, (seg(x, i) - Vec3(0, 0.3, 0)).norm() - 0.25);
+    min_ground = std::min(min_ground, x[3 * i + 1]);
+  }
+  EXPECT_GT(min_sphere, -0.01);  // within the 1 cm contact thickness
+  EXPECT_GT(min_ground, -0.01);
+  EXPECT_LT(min_ground, 0.02);  // it did drape down to the ground
+}
+
+// One forward and backward pass with a fixed number of threads.
+void run_with_threads(int threads, VecX& xN, std::vector<VecX>& dU, VecX& dv0) {
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+  ClothSystem sys(spec_from(R"({"nx": 32, "ny": 32, "pins": "top_corners"})"), 1.0 / 60);
+  VecX x0, v0, dx0;
+  sys.initial_state(x0, v0);
+  std::vector<VecX> U(6, VecX::Constant(x0.size(), 0.001));
+  Rollout r;
+  ASSERT_TRUE(simulate(sys, x0, v0, U, r));
+  struct Cost : StateCost {
+    bool active(int n) const override { return n == 6; }
+    double eval(int, const VecX& x, const VecX&, VecX& gx, VecX&) const override {
+      gx += x;
+      return 0.5 * x.squaredNorm();
+    }
+  } cost;
+  backward(sys, r, U, cost, dU, dx0, dv0);
+  xN = r.x.back();
+}
+
+TEST(ClothSystem, BitIdenticalForOneAndTwoThreads) {
+  VecX x1, x2, g1, g2;
+  std::vector<VecX> d1, d2;
+  run_with_threads(1, x1, d1, g1);
+  run_with_threads(2, x2, d2, g2);
+  ASSERT_GT(g1.norm(), 0);
+  EXPECT_TRUE(x1 == x2);
+  EXPECT_TRUE(g1 == g2);
+  for (size_t n = 0; n < d1.size(); ++n) EXPECT_TRUE(d1[n] == d2[n]) << n;
+}
+
+}  // namespace
+}  // namespace kf
