@@ -1,5 +1,7 @@
 #include "render/frame_renderer.h"
 
+#include <fstream>
+
 #include "core/error.h"
 
 namespace kf::render {
@@ -17,6 +19,14 @@ RunData load_run(const fs::path& run_dir) {
     throw InputError(d + ": trajectory.bin has " + std::to_string(run.trajectory.particles) +
                      " particles but scene.json describes " + std::to_string(run.scene.particles()));
   if (run.trajectory.frames() == 0) throw InputError(d + ": trajectory.bin holds no frames");
+  // The run keeps the original scene's name beside its copy; without it the directory names the run.
+  std::ifstream names(run_dir / "scene_name.txt");
+  std::string name;
+  if (std::getline(names, name) && !name.empty())
+    run.scene.name = name;
+  else
+    run.scene.name = fs::absolute(run_dir).lexically_normal().filename().string();
+  if (run.scene.name.empty()) run.scene.name = fs::absolute(run_dir).lexically_normal().parent_path().filename().string();
   return run;
 }
 
