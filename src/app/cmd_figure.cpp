@@ -1,12 +1,49 @@
-// keyframe figure: compose figure sheets from run directories.
+// keyframe figure RUN_DIR...: compose a labelled figure sheet from run directories.
+#include <iostream>
+#include <sstream>
+
 #include "app/commands.h"
+#include "core/error.h"
+#include "render/figure/make_figure.h"
 
 namespace kf {
 
 void add_figure_command(CLI::App& app) {
-  auto* sub = app.add_subcommand("figure", "compose figure sheets from run directories (not available yet)");
-  sub->allow_extras();
-  sub->callback([] { throw NotReady("'figure' is not available yet in this build"); });
+  auto* sub = app.add_subcommand("figure", "compose a labelled figure sheet (out/figures/NAME.png) from run directories");
+  auto req = std::make_shared<render::FigureRequest>();
+  auto frames = std::make_shared<std::string>();
+  auto size = std::make_shared<std::string>();
+  sub->add_option("RUN_DIR", req->run_dirs, "run directories, one row each")->required();
+  sub->add_option("--frames", *frames, "comma-separated frames, e.g. 0,30,60 (default: 0, keyframes, last)");
+  sub->add_option("--name", req->name, "figure name (default: the first run's scene name)");
+  sub->add_option("--out-dir", req->out_dir, "where the sheet goes")->capture_default_str();
+  sub->add_option("--backend", req->backend, "osmesa | embree")->capture_default_str();
+  sub->add_option("--size", *size, "tile size WxH in pixels (default 400x300)");
+  sub->add_option("--spp", req->spp, "samples per pixel (default: back end default)");
+  sub->add_flag("--overlay", req->overlay, "superimpose the frames into one tile per run (trails)");
+  sub->callback([=] {
+    render::FigureRequest r = *req;
+    if (!frames->empty()) {
+      std::stringstream ss(*frames);
+      std::string item;
+      while (std::getline(ss, item, ',')) {
+        try {
+          size_t used = 0;
+          r.frames.push_back(std::stoi(item, &used));
+          if (used != item.size()) throw std::invalid_argument(item);
+        } catch (const std::exception&) {
+          throw InputError("--frames: expected comma-separated frame numbers, got \"" + *frames + "\"");
+        }
+      }
+    }
+    if (!size->empty()) {
+      char x = 0;
+      std::stringstream ss(*size);
+      if (!(ss >> r.width >> x >> r.height) || (x != 'x' && x != 'X') || !ss.eof())
+        throw InputError("--size: expected WxH such as 400x300, got \"" + *size + "\"");
+    }
+    std::cout << "figure -> " << render::make_figure(r).string() << "\n";
+  });
 }
 
 }  // namespace kf

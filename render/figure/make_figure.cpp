@@ -1,0 +1,77 @@
+#include "render/figure/make_figure.h"
+
+#include <algorithm>
+#include <cctype>
+#include <set>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "render/figure/figure_sheet.h"
+#include "render/frame_renderer.h"
+
+namespace kf::render {
+
+namespace {
+
+std::vector<int> default_frames(const RunData& run) {
+  std::set<int> f = {0, run.trajectory.frames() - 1};
+  for (const auto& o : run.scene.objectives)
+    if (o.frame < run.trajectory.frames()) f.insert(o.frame);
+  std::vector<int> v(f.begin(), f.end());
+  if (v.size() > 6) {  // keep first, last and evenly spaced keyframes
+    std::vector<int> picked;
+    for (int k = 0; k < 6; ++k) picked.push_back(v[size_t(k * (v.size() - 1) / 5)]);
+    v = picked;
+  }
+  return v;
+}
+
+bool is_keyframe(const RunData& run, int frame) {
+  return std::any_of(run.scene.objectives.begin(), run.scene.objectives.end(),
+                     [&](const auto& o) { return o.frame == frame; });
+}
+
+}  // namespace
+
+std::filesystem::path make_figure(const FigureRequest& r) {
+  if (r.run_dirs.empty()) throw InputError("figure: expected at least one run directory");
+  make_backend(r.backend);  // unknown names fail before any work
+  if (r.width < 16 || r.height < 16 || r.width > 4096 || r.height > 4096)
+    throw InputError("figure: tile size " + std::to_string(r.width) + "x" + std::to_string(r.height) +
+                     " out of range (each side 16..4096 pixels)");
+  for (char c : r.name)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.'))
+      throw InputError("figure: --name \"" + r.name + "\" may use only letters, digits, '-', '_' and '.'");
+  std::vector<RunData> runs;
+  for (const auto& d : r.run_dirs) runs.push_back(load_run(d));
+  for (size_t k = 0; k < runs.size(); ++k)
+    for (int f : r.frames)
+      if (f < 0 || f >= runs[k].trajectory.frames())
+        throw InputError("figure: frame " + std::to_string(f) + " out of range: " + r.run_dirs[k].string() +
+                         " has frames 0.." + std::to_string(runs[k].trajectory.frames() - 1));
+  std::vector<FigureRow> rows;
+  for (const RunData& run : runs) {
+    FrameRenderer renderer(run, r.backend, {r.width, r.height, r.spp});
+    const std::vector<int> frames = r.frames.empty() ? default_frames(run) : r.frames;
+    FigureRow row;
+    row.label = run.scene.name;
+    std::vector<Image> images;
+    for (int f : frames) images.push_back(renderer.render(f));
+    if (r.overlay) {
+      row.tiles.push_back(overlay_frames(images));
+      row.captions.push_back("FRAMES " + std::to_string(frames.front()) + "-" + std::to_string(frames.back()));
+    } else {
+      row.tiles = std::move(images);
+      for (int f : frames) row.captions.push_back("FRAME " + std::to_string(f) + (is_keyframe(run, f) ? " (KEY)" : ""));
+    }
+    rows.push_back(std::move(row));
+  }
+  const std::string name = r.name.empty() ? runs.front().scene.name : r.name;
+  const Image sheet = compose_sheet(name, rows);
+  ensure_directory(r.out_dir);
+  const auto path = r.out_dir / (name + ".png");
+  write_png(path, sheet);
+  return path;
+}
+
+}  // namespace kf::render

@@ -1,0 +1,48 @@
+#include "render/frame_renderer.h"
+
+#include <fstream>
+
+#include "core/error.h"
+
+namespace kf::render {
+
+namespace fs = std::filesystem;
+
+RunData load_run(const fs::path& run_dir) {
+  const std::string d = run_dir.string();
+  if (!fs::is_directory(run_dir)) throw InputError(d + ": not a run directory (does not exist)");
+  if (!fs::exists(run_dir / "scene.json")) throw InputError(d + ": not a run directory (no scene.json)");
+  if (!fs::exists(run_dir / "trajectory.bin"))
+    throw InputError(d + ": no trajectory.bin to render (run 'keyframe simulate' or 'keyframe run' first)");
+  RunData run{load_scene(run_dir / "scene.json"), load_trajectory(run_dir / "trajectory.bin")};
+  if (run.trajectory.particles != run.scene.particles())
+    throw InputError(d + ": trajectory.bin has " + std::to_string(run.trajectory.particles) +
+                     " particles but scene.json describes " + std::to_string(run.scene.particles()));
+  if (run.trajectory.frames() == 0) throw InputError(d + ": trajectory.bin holds no frames");
+  // The run keeps the original scene's name beside its copy; without it the directory names the run.
+  std::ifstream names(run_dir / "scene_name.txt");
+  std::string name;
+  if (std::getline(names, name) && !name.empty())
+    run.scene.name = name;
+  else
+    run.scene.name = fs::absolute(run_dir).lexically_normal().filename().string();
+  if (run.scene.name.empty()) run.scene.name = fs::absolute(run_dir).lexically_normal().parent_path().filename().string();
+  return run;
+}
+
+FrameRenderer::FrameRenderer(const RunData& run, const std::string& backend, RenderSettings settings)
+    : run_(run), backend_(make_backend(backend)), settings_(settings) {
+  if (settings_.width == 0) settings_.width = run.scene.render.width;
+  if (settings_.height == 0) settings_.height = run.scene.render.height;
+  if (settings_.spp == 0) settings_.spp = backend == "embree" ? run.scene.render.samples : 4;
+  bounds_ = scene_bounds(run.scene, run.trajectory);
+  camera_ = make_camera(run.scene.render, bounds_, run.scene.flock.has_value(), settings_.width, settings_.height);
+}
+
+Image FrameRenderer::render(int frame, double orbit) {
+  build_frame_geometry(run_.scene, run_.trajectory, frame, bounds_, geometry_);
+  const Camera cam = orbit == 0.0 ? camera_ : camera_.orbited(orbit);
+  return backend_->render(geometry_, cam, run_.scene.render, settings_);
+}
+
+}  // namespace kf::render

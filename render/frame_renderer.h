@@ -1,0 +1,39 @@
+#pragma once
+// Loading a run directory and rendering its frames with one back end (shared by render_run and figures).
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "core/trajectory.h"
+#include "render/backend.h"
+#include "scene/scene.h"
+
+namespace kf::render {
+
+struct RunData {
+  Scene scene;
+  Trajectory trajectory;
+};
+
+// Reads RUN_DIR/scene.json and RUN_DIR/trajectory.bin and checks they belong together.
+// Throws InputError with one line naming the directory or file.
+RunData load_run(const std::filesystem::path& run_dir);
+
+class FrameRenderer {
+ public:
+  // `backend`: a name from backend_names(); `settings` with 0 sizes/spp take the scene's values.
+  FrameRenderer(const RunData& run, const std::string& backend, RenderSettings settings);
+  // Frame `frame` (0 <= frame < trajectory frames), camera orbited about Y by `orbit` radians.
+  Image render(int frame, double orbit = 0.0);
+  const RenderSettings& settings() const { return settings_; }
+
+ private:
+  const RunData& run_;
+  std::unique_ptr<Backend> backend_;
+  RenderSettings settings_;
+  Bounds bounds_;
+  Camera camera_;
+  FrameGeometry geometry_;
+};
+
+}  // namespace kf::render

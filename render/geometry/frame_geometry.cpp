@@ -1,0 +1,342 @@
+#include "render/geometry/frame_geometry.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+namespace kf::render {
+
+namespace {
+
+std::atomic<long> g_ground_ids{0};
+
+void set3(float* d, const Vec3& v) {
+  d[0] = float(v.x());
+  d[1] = float(v.y());
+  d[2] = float(v.z());
+}
+
+uint32_t add_vertex(Mesh& m, const Vec3& p, const Vec3& n, const Vec3& front, const Vec3& back) {
+  Vertex v;
+  set3(v.p, p);
+  set3(v.n, n);
+  set3(v.front, front);
+  set3(v.back, back);
+  m.vertices.push_back(v);
+  return uint32_t(m.vertices.size() - 1);
+}
+
+// A flat triangle, front side counter-clockwise.
+void add_flat_triangle(Mesh& m, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& color) {
+  const Vec3 n = (b - a).cross(c - a).normalized();
+  const uint32_t i = add_vertex(m, a, n, color, color);
+  add_vertex(m, b, n, color, color);
+  add_vertex(m, c, n, color, color);
+  m.indices.insert(m.indices.end(), {i, i + 1, i + 2});
+}
+
+// Quad a b c d counter-clockwise seen from the front side, flat.
+void add_flat_quad(Mesh& m, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& n,
+                   const Vec3& color) {
+  const uint32_t i = add_vertex(m, a, n, color, color);
+  add_vertex(m, b, n, color, color);
+  add_vertex(m, c, n, color, color);
+  add_vertex(m, d, n, color, color);
+  m.indices.insert(m.indices.end(), {i, i + 1, i + 2, i, i + 2, i + 3});
+}
+
+Vec3 any_perpendicular(const Vec3& n) {
+  const Vec3 a = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitZ();
+  return n.cross(a).normalized();
+}
+
+// A strip of `width` metres along `points` lying in the plane with normal `n`.
+void add_ribbon(Mesh& m, const std::vector<Vec3>& points, bool closed, double width, const Vec3& n,
+                const Vec3& color) {
+  const size_t count = points.size();
+  if (count < 2) return;
+  const size_t segments = closed ? count : count - 1;
+  for (size_t s = 0; s < segments; ++s) {
+    const Vec3 a = points[s], b = points[(s + 1) % count];
+    const Vec3 d = b - a;
+    if (d.norm() < 1e-12) continue;
+    const Vec3 t = d.normalized();
+    const Vec3 side = n.cross(t) * (0.5 * width);
+    // Extending each segment by half a width closes the gaps at the corners.
+    const Vec3 a2 = a - t * (0.5 * width), b2 = b + t * (0.5 * width);
+    add_flat_quad(m, a2 - side, b2 - side, b2 + side, a2 + side, n, color);
+  }
+}
+
+std::vector<Vec3> circle_points(const Vec3& c, const Vec3& n, double radius, int segments) {
+  const Vec3 u = any_perpendicular(n), w = n.cross(u);
+  std::vector<Vec3> pts;
+  for (int k = 0; k < segments; ++k) {
+    const double a = 2.0 * M_PI * k / segments;
+    pts.push_back(c + radius * (std::cos(a) * u + std::sin(a) * w));
+  }
+  return pts;
+}
+
+void add_disc(Mesh& m, const Vec3& c, const Vec3& n, double radius, const Vec3& color) {
+  const auto pts = circle_points(c, n, radius, 24);
+  const uint32_t center = add_vertex(m, c, n, color, color);
+  for (size_t k = 0; k < pts.size(); ++k) add_vertex(m, pts[k], n, color, color);
+  for (uint32_t k = 0; k < pts.size(); ++k)
+    m.indices.insert(m.indices.end(), {center, center + 1 + k, center + 1 + (k + 1) % uint32_t(pts.size())});
+}
+
+// A smooth surface from a (u, v) parameterisation with `nu` x `nv` quads, both directions periodic.
+template <class Surface>
+void add_periodic_surface(Mesh& m, int nu, int nv, const Vec3& color, Surface surface) {
+  const uint32_t base = uint32_t(m.vertices.size());
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i <= nu; ++i) {
+      Vec3 p, n;
+      surface(2.0 * M_PI * i / nu, 2.0 * M_PI * j / nv, p, n);
+      add_vertex(m, p, n, color, color);
+    }
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const uint32_t a = base + j * (nu + 1) + i, b = a + 1, c = a + (nu + 1) + 1, d = a + (nu + 1);
+      m.indices.insert(m.indices.end(), {a, b, c, a, c, d});
+    }
+}
+
+void add_sphere(Mesh& m, const Vec3& center, double r, const Vec3& color) {
+  add_periodic_surface(m, 48, 24, color, [&](double u, double v, Vec3& p, Vec3& n) {
+    const double theta = 0.5 * v;  // 0..pi
+    n = Vec3(std::sin(theta) * std::cos(u), std::cos(theta), -std::sin(theta) * std::sin(u));
+    p = center + r * n;
+  });
+}
+
+void add_torus(Mesh& m, const Vec3& center, const Vec3& axis, double R, double r, const Vec3& color) {
+  const Vec3 a = axis.normalized(), e1 = any_perpendicular(a), e2 = a.cross(e1);
+  add_periodic_surface(m, 64, 20, color, [&](double u, double v, Vec3& p, Vec3& n) {
+    const Vec3 radial = std::cos(u) * e1 + std::sin(u) * e2;
+    n = std::cos(v) * radial + std::sin(v) * a;
+    p = center + R * radial + r * n;
+  });
+}
+
+// Small octahedron: a target point in space.
+void add_marker(Mesh& m, const Vec3& c, double s, const Vec3& color) {
+  const Vec3 X = Vec3::UnitX() * s, Y = Vec3::UnitY() * s, Z = Vec3::UnitZ() * s;
+  const Vec3 dirs[4] = {X, Z, -X, -Z};
+  for (int k = 0; k < 4; ++k) {
+    add_flat_triangle(m, c + Y, c + dirs[k], c + dirs[(k + 1) % 4], color);
+    add_flat_triangle(m, c - Y, c + dirs[(k + 1) % 4], c + dirs[k], color);
+  }
+}
+
+Vec3 mix(const Vec3& a, const Vec3& b, double t) { return (1 - t) * a + t * b; }
+
+GroundPlane ground_plane(const Scene& scene, const Bounds& bounds) {
+  GroundPlane g;
+  if (scene.cloth) {
+    for (const auto& c : scene.cloth->colliders)
+      if (c.type == "ground") {
+        g.normal = c.axis.normalized();
+        g.offset = g.normal.dot(c.center);
+        return g;
+      }
+    // No floor in the scene: put one just below everything so the shadows show the height.
+    g.offset = bounds.empty() ? 0.0 : std::min(0.0, bounds.lo.y() - 0.05 * std::max(bounds.radius(), 0.25));
+  }
+  return g;
+}
+
+double scene_scale(const Bounds& b) { return std::max(b.empty() ? 1.0 : b.radius(), 0.25); }
+
+// A big square of alternating tiles so motion and distance read.
+void build_ground(const Scene& scene, const Bounds& bounds, const GroundPlane& plane, double scale, Mesh& m) {
+  m.clear();
+  const RenderSpec& rs = scene.render;
+  if (!rs.ground) return;
+  const Vec3 n = plane.normal;
+  const Vec3 u = std::abs(n.y()) > 0.9 ? Vec3::UnitX() : any_perpendicular(n);
+  const Vec3 w = n.cross(u);
+  const Vec3 c0 = bounds.empty() ? Vec3::Zero() : bounds.center();
+  const Vec3 origin = c0 - n * (n.dot(c0) - plane.offset);
+  const double tile = 0.25 * std::pow(10.0, std::floor(std::log10(scale) + 0.5));
+  const int half_tiles = std::min(60, int(std::ceil(8.0 * scale / tile)));
+  // Tiles are aligned to world multiples of `tile` so they stay put between runs of different length.
+  const double su = std::floor(origin.dot(u) / tile), sw = std::floor(origin.dot(w) / tile);
+  const Vec3 base = origin - u * (origin.dot(u) - su * tile) - w * (origin.dot(w) - sw * tile);
+  const Vec3 dark = rs.ground_color * 0.93;
+  for (int b = -half_tiles; b < half_tiles; ++b)
+    for (int a = -half_tiles; a < half_tiles; ++a) {
+      const Vec3 p = base + u * (a * tile) + w * (b * tile);
+      const bool odd = ((a + b + long(su) + long(sw)) & 1) != 0;
+      add_flat_quad(m, p, p + u * tile, p + (u + w) * tile, p + w * tile, n, odd ? dark : rs.ground_color);
+    }
+}
+
+Vec3 heading_of(const Trajectory& traj, int f, int i) {
+  Vec2 h(traj.v[f][3 * i], traj.v[f][3 * i + 2]);
+  if (h.norm() < 1e-9) {
+    const int g = f + 1 < traj.frames() ? f + 1 : f, e = f + 1 < traj.frames() ? f : std::max(f - 1, 0);
+    h = Vec2(traj.x[g][3 * i] - traj.x[e][3 * i], traj.x[g][3 * i + 2] - traj.x[e][3 * i + 2]);
+  }
+  if (h.norm() < 1e-12) return Vec3::UnitX();
+  h.normalize();
+  return Vec3(h.x(), 0.0, h.y());
+}
+
+// A low dart pointing along the heading; its ridge catches the light so the direction reads from above.
+void add_agent(Mesh& m, const Vec3& pos, const Vec3& heading, double len, const Vec3& color) {
+  const Vec3 up = Vec3::UnitY(), side = heading.cross(up).normalized();
+  const Vec3 base(pos.x(), pos.y(), pos.z());
+  const Vec3 tip = base + heading * (0.55 * len), notch = base - heading * (0.2 * len);
+  const Vec3 left = base - heading * (0.45 * len) - side * (0.38 * len);
+  const Vec3 right = base - heading * (0.45 * len) + side * (0.38 * len);
+  const Vec3 top = base + up * (0.22 * len);
+  add_flat_triangle(m, top, left, tip, color);
+  add_flat_triangle(m, top, tip, right, color);
+  add_flat_triangle(m, top, notch, left, color);
+  add_flat_triangle(m, top, right, notch, color);
+}
+
+void build_flock(const Scene& scene, const Trajectory& traj, int f, double scale, const GroundPlane& plane,
+                 FrameGeometry& g) {
+  const RenderSpec& rs = scene.render;
+  const int p = traj.particles;
+  const double len = rs.agent_size, line = 0.12 * len, lift = 0.002 * scale;
+  const Vec3 n = Vec3::UnitY();
+  auto on_ground = [&](double x, double z) { return Vec3(x, plane.offset + lift, z); };
+  std::vector<char> highlighted(p, 0);
+  // The next shape keyframe is drawn strongly, the others faded.
+  int next_shape = -1;
+  for (size_t k = 0; k < scene.objectives.size(); ++k) {
+    const auto& o = scene.objectives[k];
+    if (o.type == "shape" && o.frame >= f &&
+        (next_shape < 0 || o.frame < scene.objectives[next_shape].frame))
+      next_shape = int(k);
+  }
+  std::vector<const ObjectiveSpec*> com;
+  for (size_t k = 0; k < scene.objectives.size(); ++k) {
+    const auto& o = scene.objectives[k];
+    if (o.type == "shape") {
+      std::vector<Vec3> pts;
+      for (const Vec2& q : o.polygon) pts.push_back(on_ground(q.x(), q.y()));
+      const Vec3 color = int(k) == next_shape ? rs.target_color : mix(rs.target_color, rs.ground_color, 0.6);
+      add_ribbon(g.marks, pts, true, line, n, color);
+    } else if (o.type == "center_of_mass") {
+      com.push_back(&o);
+    } else if (o.type == "position") {
+      const bool single = o.particles.size() == 1;
+      for (size_t t = 0; t < o.targets.size(); ++t) {
+        const Vec3& q = o.targets[t];
+        if (single) {
+          add_ribbon(g.marks, circle_points(on_ground(q.x(), q.z()), n, 0.6 * len, 32), true, 0.6 * line, n,
+                     rs.target_color);
+        } else {
+          add_disc(g.marks, on_ground(q.x(), q.z()), n, 0.15 * len, rs.target_color);
+        }
+      }
+      if (single) highlighted[o.particles[0]] = 1;
+    }
+  }
+  if (!com.empty()) {
+    std::stable_sort(com.begin(), com.end(), [](auto* a, auto* b) { return a->frame < b->frame; });
+    Vec3 c0 = Vec3::Zero();
+    for (int i = 0; i < p; ++i) c0 += seg(traj.x[0], i);
+    c0 /= std::max(p, 1);
+    std::vector<Vec3> pts = {on_ground(c0.x(), c0.z())};
+    for (auto* o : com) pts.push_back(on_ground(o->targets[0].x(), o->targets[0].z()));
+    add_ribbon(g.marks, pts, false, line, n, rs.path_color);
+    for (size_t k = 1; k < pts.size(); ++k) add_disc(g.marks, pts[k], n, 2.0 * line, rs.path_color);
+  }
+  for (int i = 0; i < p; ++i) {
+    const Vec3 x = seg(traj.x[f], i);
+    const Vec3 pos(x.x(), plane.offset + lift, x.z());
+    add_agent(g.objects, pos, heading_of(traj, f, i), len, highlighted[i] ? rs.highlight_color : rs.agent_color);
+    if (highlighted[i])
+      add_ribbon(g.marks, circle_points(pos, n, 0.9 * len, 40), true, line, n, rs.highlight_color);
+  }
+}
+
+void build_cloth(const Scene& scene, const Trajectory& traj, int f, double scale, FrameGeometry& g) {
+  const RenderSpec& rs = scene.render;
+  const int nx = scene.cloth->nx, ny = scene.cloth->ny;
+  const VecX& x = traj.x[f];
+  auto P = [&](int i, int j) -> Vec3 { return seg(x, j * nx + i); };
+  // Smooth normals from central differences of the grid.
+  std::vector<Vec3> normal(size_t(nx) * ny);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const Vec3 du = P(std::min(i + 1, nx - 1), j) - P(std::max(i - 1, 0), j);
+      const Vec3 dv = P(i, std::min(j + 1, ny - 1)) - P(i, std::max(j - 1, 0));
+      const Vec3 c = du.cross(dv);
+      normal[size_t(j) * nx + i] = c.norm() > 1e-15 ? c.normalized() : Vec3::UnitY();
+    }
+  const int squares = rs.checker;
+  Mesh& m = g.objects;
+  for (int j = 0; j + 1 < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {
+      bool odd = false;
+      if (squares > 0) {
+        const int si = (i * squares) / (nx - 1), sj = (j * squares) / (nx - 1);
+        odd = ((si + sj) & 1) != 0;
+      }
+      const Vec3 front = odd ? rs.cloth_front * 0.72 : rs.cloth_front;
+      const Vec3 back = odd ? rs.cloth_back * 0.8 : rs.cloth_back;
+      const uint32_t base = uint32_t(m.vertices.size());
+      const int ci[4] = {i, i + 1, i + 1, i}, cj[4] = {j, j, j + 1, j + 1};
+      for (int k = 0; k < 4; ++k)
+        add_vertex(m, P(ci[k], cj[k]), normal[size_t(cj[k]) * nx + ci[k]], front, back);
+      m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    }
+  for (const auto& c : scene.cloth->colliders) {
+    if (c.type == "sphere") add_sphere(m, c.center, c.radius, rs.collider_color);
+    if (c.type == "torus") add_torus(m, c.center, c.axis, c.radius, c.tube_radius, rs.collider_color);
+  }
+  size_t markers = 0;
+  for (const auto& o : scene.objectives)
+    if (o.type == "position")
+      for (const Vec3& q : o.targets)
+        if (markers++ < 4096) add_marker(m, q, 0.012 * scale, rs.target_color);
+}
+
+}  // namespace
+
+Bounds scene_bounds(const Scene& scene, const Trajectory& traj) {
+  Bounds b;
+  for (const VecX& x : traj.x)
+    for (int i = 0; i < traj.particles; ++i) b.add(seg(x, i));
+  for (const auto& o : scene.objectives) {
+    for (const Vec3& q : o.targets) b.add(q);
+    for (const Vec2& q : o.polygon) b.add(Vec3(q.x(), 0.0, q.y()));
+  }
+  if (scene.cloth)
+    for (const auto& c : scene.cloth->colliders) {
+      if (c.type == "sphere") {
+        b.add(c.center - Vec3::Constant(c.radius));
+        b.add(c.center + Vec3::Constant(c.radius));
+      } else if (c.type == "torus") {
+        b.add(c.center - Vec3::Constant(c.radius + c.tube_radius));
+        b.add(c.center + Vec3::Constant(c.radius + c.tube_radius));
+      }
+    }
+  return b;
+}
+
+void build_frame_geometry(const Scene& scene, const Trajectory& traj, int frame, const Bounds& bounds,
+                          FrameGeometry& out) {
+  out.scale = scene_scale(bounds);
+  const GroundPlane plane = ground_plane(scene, bounds);
+  if (out.ground.vertices.empty() || plane.normal != out.plane.normal || plane.offset != out.plane.offset) {
+    out.plane = plane;
+    build_ground(scene, bounds, plane, out.scale, out.ground);
+    out.ground_id = ++g_ground_ids;
+  }
+  out.marks.clear();
+  out.objects.clear();
+  if (scene.flock) build_flock(scene, traj, frame, out.scale, out.plane, out);
+  if (scene.cloth) build_cloth(scene, traj, frame, out.scale, out);
+}
+
+}  // namespace kf::render

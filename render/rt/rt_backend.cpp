@@ -1,0 +1,244 @@
+// Embree back end: path-traced direct light from a sun of finite size (soft shadows) plus sky light with
+// ambient occlusion, N jittered samples per pixel, tiles in parallel with TBB.
+//
+// Every pixel seeds its own random sequence from its coordinates, so the image does not depend on the
+// thread count or the tile schedule.
+#include <tbb/blocked_range2d.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+#include "render/backend.h"
+#include "render/rt/embree_handles.h"
+
+namespace kf::render {
+
+namespace {
+
+uint32_t pcg_hash(uint32_t v) {
+  const uint32_t state = v * 747796405u + 2891336453u;
+  const uint32_t word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+  return (word >> 22u) ^ word;
+}
+
+struct Rng {
+  uint32_t s;
+  float next() {
+    s = pcg_hash(s);
+    return float(s >> 8) * (1.0f / 16777216.0f);
+  }
+};
+
+struct V3 {
+  float x, y, z;
+};
+inline V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline V3 operator*(V3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
+inline V3 mul(V3 a, V3 b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
+inline float dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+inline V3 normalize(V3 a) { return a * (1.0f / std::sqrt(std::max(dot(a, a), 1e-30f))); }
+inline V3 from(const Vec3& v) { return {float(v.x()), float(v.y()), float(v.z())}; }
+inline V3 from(const float* f) { return {f[0], f[1], f[2]}; }
+
+void orthonormal(V3 n, V3& t, V3& b) {
+  t = normalize(std::abs(n.x) < 0.9f ? cross(n, V3{1, 0, 0}) : cross(n, V3{0, 0, 1}));
+  b = cross(n, t);
+}
+
+// One triangle mesh in the Embree scene, rebuilt when its size changes and refitted otherwise.
+struct RtMesh {
+  RTCGeometry geom = nullptr;
+  unsigned id = RTC_INVALID_GEOMETRY_ID;
+  size_t vertices = 0, triangles = 0;
+  const Mesh* source = nullptr;  // the frame's mesh, for shading attributes
+
+  void update(RTCDevice device, RTCScene scene, const Mesh& m, bool deforming) {
+    source = &m;
+    const bool same = geom && m.vertices.size() == vertices && size_t(m.triangles()) == triangles;
+    if (!same) {
+      release(scene);
+      if (m.triangles() == 0) return;
+      geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+      // Cloth keeps its topology: refitting the BVH is far cheaper than rebuilding it.
+      rtcSetGeometryBuildQuality(geom, deforming ? RTC_BUILD_QUALITY_REFIT : RTC_BUILD_QUALITY_MEDIUM);
+      vertices = m.vertices.size();
+      triangles = size_t(m.triangles());
+      rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertices);
+      auto* idx = static_cast<uint32_t*>(
+          rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), triangles));
+      std::copy(m.indices.begin(), m.indices.end(), idx);
+      id = rtcAttachGeometry(scene, geom);
+    } else {
+      auto* idx = static_cast<uint32_t*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0));
+      std::copy(m.indices.begin(), m.indices.end(), idx);
+      rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0);
+    }
+    auto* p = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
+    for (size_t i = 0; i < vertices; ++i)
+      for (int c = 0; c < 3; ++c) p[3 * i + c] = m.vertices[i].p[c];
+    rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
+    rtcCommitGeometry(geom);
+  }
+  void release(RTCScene scene) {
+    if (!geom) return;
+    rtcDetachGeometry(scene, id);
+    rtcReleaseGeometry(geom);
+    geom = nullptr;
+    id = RTC_INVALID_GEOMETRY_ID;
+    vertices = triangles = 0;
+  }
+};
+
+class RtBackend final : public Backend {
+ public:
+  RtBackend() : scene_(device_) {}
+  ~RtBackend() override {
+    for (auto& m : meshes_) m.release(scene_.get());
+  }
+
+  Image render(const FrameGeometry& g, const Camera& camera, const RenderSpec& look,
+               const RenderSettings& settings) override {
+    if (g.ground_id != ground_id_) {
+      meshes_[0].update(device_.get(), scene_.get(), g.ground, false);
+      ground_id_ = g.ground_id;
+    }
+    meshes_[0].source = &g.ground;
+    meshes_[1].update(device_.get(), scene_.get(), g.marks, false);
+    meshes_[2].update(device_.get(), scene_.get(), g.objects, true);
+    rtcCommitScene(scene_.get());
+
+    const int W = settings.width, H = settings.height, spp = std::max(settings.spp, 1);
+    Image img(W, H, 3);
+    Vec3 fw, rt, up;
+    camera.basis(fw, rt, up);
+    const float tan_half = float(std::tan(0.5 * camera.fov * M_PI / 180.0));
+    Shading sh;
+    sh.eye = from(camera.eye);
+    sh.forward = from(fw);
+    sh.right = from(rt) * (tan_half * float(camera.aspect));
+    sh.up = from(up) * tan_half;
+    sh.sun = from(look.light_direction);
+    orthonormal(sh.sun, sh.sun_t, sh.sun_b);
+    sh.sun_radius = float(std::tan(0.5 * look.light_angle * M_PI / 180.0));
+    sh.ambient = float(look.ambient);
+    const double up_sun = std::max(look.light_direction.dot(g.plane.normal), 0.2);
+    sh.norm_k = float(1.0 / (look.ambient + up_sun));
+    sh.eps = float(1e-4 * g.scale);
+    sh.ao_distance = float(0.5 * g.scale);
+    sh.background = from(look.background);
+
+    constexpr int kTile = 16;
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, (H + kTile - 1) / kTile, 1, 0, (W + kTile - 1) / kTile, 1),
+                      [&](const tbb::blocked_range2d<int>& r) {
+                        RTCIntersectContext ctx;
+                        rtcInitIntersectContext(&ctx);
+                        for (int ty = r.rows().begin(); ty < r.rows().end(); ++ty)
+                          for (int tx = r.cols().begin(); tx < r.cols().end(); ++tx)
+                            for (int y = ty * kTile; y < std::min(H, (ty + 1) * kTile); ++y)
+                              for (int x = tx * kTile; x < std::min(W, (tx + 1) * kTile); ++x)
+                                shade_pixel(ctx, sh, x, y, W, H, spp, img.at(x, y));
+                      });
+    return img;
+  }
+
+ private:
+  struct Shading {
+    V3 eye, forward, right, up, sun, sun_t, sun_b, background;
+    float sun_radius, ambient, norm_k, eps, ao_distance;
+  };
+
+  bool occluded(RTCIntersectContext& ctx, V3 o, V3 d, float tfar) const {
+    RTCRay ray;
+    ray.org_x = o.x, ray.org_y = o.y, ray.org_z = o.z;
+    ray.dir_x = d.x, ray.dir_y = d.y, ray.dir_z = d.z;
+    ray.tnear = 0.0f;
+    ray.tfar = tfar;
+    ray.time = 0.0f;
+    ray.mask = ~0u;
+    ray.id = 0;
+    ray.flags = 0;
+    rtcOccluded1(scene_.get(), &ctx, &ray);
+    return ray.tfar < 0.0f;
+  }
+
+  void shade_pixel(RTCIntersectContext& ctx, const Shading& sh, int x, int y, int W, int H, int spp,
+                   uint8_t* out) const {
+    Rng rng{pcg_hash(uint32_t(y) * 0x9E3779B9u ^ pcg_hash(uint32_t(x)))};
+    V3 sum{0, 0, 0};
+    for (int s = 0; s < spp; ++s) {
+      const float px = (float(x) + rng.next()) / float(W) * 2.0f - 1.0f;
+      const float py = 1.0f - (float(y) + rng.next()) / float(H) * 2.0f;
+      const V3 dir = normalize(sh.forward + sh.right * px + sh.up * py);
+      RTCRayHit rh;
+      rh.ray.org_x = sh.eye.x, rh.ray.org_y = sh.eye.y, rh.ray.org_z = sh.eye.z;
+      rh.ray.dir_x = dir.x, rh.ray.dir_y = dir.y, rh.ray.dir_z = dir.z;
+      rh.ray.tnear = 0.0f;
+      rh.ray.tfar = INFINITY;
+      rh.ray.time = 0.0f;
+      rh.ray.mask = ~0u;
+      rh.ray.id = 0;
+      rh.ray.flags = 0;
+      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+      rtcIntersect1(scene_.get(), &ctx, &rh);
+      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+        sum = sum + sh.background;
+        continue;
+      }
+      const Mesh* m = nullptr;
+      for (const auto& rm : meshes_)
+        if (rm.id == rh.hit.geomID) m = rm.source;
+      const uint32_t* tri = &m->indices[size_t(rh.hit.primID) * 3];
+      const Vertex &a = m->vertices[tri[0]], &b = m->vertices[tri[1]], &c = m->vertices[tri[2]];
+      const float u = rh.hit.u, v = rh.hit.v, w = 1.0f - u - v;
+      V3 n = normalize(from(a.n) * w + from(b.n) * u + from(c.n) * v);
+      V3 albedo = from(a.front) * w + from(b.front) * u + from(c.front) * v;
+      if (dot(n, dir) > 0.0f) {  // seen from behind: the other side's colour
+        n = n * -1.0f;
+        albedo = from(a.back) * w + from(b.back) * u + from(c.back) * v;
+      }
+      V3 ng = normalize(V3{rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z});
+      if (dot(ng, dir) > 0.0f) ng = ng * -1.0f;
+      const V3 p = sh.eye + dir * rh.ray.tfar + ng * sh.eps;
+      // Sun: a point on a disc of directions around the light direction.
+      float sun = 0.0f;
+      {
+        const float r = sh.sun_radius * std::sqrt(rng.next()), phi = 6.2831853f * rng.next();
+        const V3 l = normalize(sh.sun + sh.sun_t * (r * std::cos(phi)) + sh.sun_b * (r * std::sin(phi)));
+        const float ndl = dot(n, l);
+        if (ndl > 0.0f && !occluded(ctx, p, l, INFINITY)) sun = ndl;
+      }
+      // Sky: cosine-weighted direction, occluded within a short distance.
+      float sky = 0.0f;
+      {
+        V3 t, bt;
+        orthonormal(n, t, bt);
+        const float r1 = rng.next(), r2 = rng.next();
+        const float rr = std::sqrt(r1), phi = 6.2831853f * r2;
+        const V3 d = normalize(t * (rr * std::cos(phi)) + bt * (rr * std::sin(phi)) + n * std::sqrt(1.0f - r1));
+        if (dot(d, ng) > 0.0f && !occluded(ctx, p, d, sh.ao_distance)) sky = 0.75f + 0.25f * n.y;
+      }
+      sum = sum + albedo * ((sh.ambient * sky + sun) * sh.norm_k);
+    }
+    const V3 c = sum * (1.0f / float(spp));
+    out[0] = uint8_t(std::lround(std::clamp(c.x, 0.0f, 1.0f) * 255.0f));
+    out[1] = uint8_t(std::lround(std::clamp(c.y, 0.0f, 1.0f) * 255.0f));
+    out[2] = uint8_t(std::lround(std::clamp(c.z, 0.0f, 1.0f) * 255.0f));
+  }
+
+  EmbreeDevice device_;
+  EmbreeScene scene_;
+  std::array<RtMesh, 3> meshes_;  // ground, marks, objects
+  long ground_id_ = -1;
+};
+
+}  // namespace
+
+std::unique_ptr<Backend> make_rt_backend() { return std::make_unique<RtBackend>(); }
+
+}  // namespace kf::render
