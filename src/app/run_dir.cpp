@@ -22,7 +22,7 @@ void prepare_run_dir(const fs::path& dir, const Scene& scene) {
   // Keep the scene's name: the copy is read back with the run directory's scene name.
   auto j = nlohmann::json::parse(os.str());
   write_file_atomic(dir / "scene.json", j.dump(2) + "\n");
-  write_file_atomic(dir / "scene_name.txt", scene.name + "\n" + fs::absolute(scene.directory).string() + "\n");
+  write_file_atomic(dir / "scene_name.txt", scene.name + "\n" + fs::absolute(scene.directory.empty() ? fs::path(".") : scene.directory).string() + "\n");
 }
 
 Scene load_run_scene(const fs::path& dir) {
