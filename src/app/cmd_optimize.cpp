@@ -3,6 +3,7 @@
 
 #include "app/commands.h"
 #include "app/optimize_job.h"
+#include "core/error.h"
 
 namespace kf {
 
@@ -14,6 +15,10 @@ void add_optimize_options(CLI::App* sub, OptimizeOptions& o) {
   sub->add_flag("--quiet", o.quiet, "no line per evaluation, only a progress display");
 }
 
+void exit_if_interrupted(const OptimizeOutcome& r) {
+  if (r.interrupted) std::exit(kExitInterrupted);
+}
+
 void add_optimize_command(CLI::App& app) {
   auto* sub = app.add_subcommand("optimize",
                                  "find the control forces that make the simulation hit the scene's keyframes "
@@ -21,9 +26,14 @@ void add_optimize_command(CLI::App& app) {
                                  "iterations.csv, convergence.png, report.json");
   auto scene = std::make_shared<std::string>();
   auto opts = std::make_shared<OptimizeOptions>();
-  sub->add_option("SCENE", *scene, "scene file (JSON)")->required();
+  sub->add_option("SCENE", *scene, "scene file (JSON); not needed with --resume");
   add_optimize_options(sub, *opts);
-  sub->callback([=] { optimize_job(*scene, *opts); });
+  sub->add_option("--resume", opts->resume,
+                  "continue an interrupted run from RUN_DIR/controls.bin (writes into RUN_DIR)");
+  sub->callback([=] {
+    if (scene->empty() && opts->resume.empty()) throw CLI::RequiredError("SCENE");
+    exit_if_interrupted(optimize_job(*scene, *opts));
+  });
 }
 
 }  // namespace kf

@@ -8,6 +8,7 @@
 namespace kf {
 
 void add_optimize_options(CLI::App* sub, OptimizeOptions& o);
+void exit_if_interrupted(const OptimizeOutcome& r);
 
 void add_run_command(CLI::App& app) {
   auto* sub = app.add_subcommand("run", "optimize the scene, then render it to <run dir>/frames/frame_%04d.png");
@@ -19,7 +20,9 @@ void add_run_command(CLI::App& app) {
   sub->add_option("--backend", *backend, "renderer: osmesa (fast preview) or embree (ray traced)")
       ->check(CLI::IsMember({"osmesa", "embree"}));
   sub->callback([=] {
-    const auto dir = optimize_job(*scene, *opts);
+    const auto outcome = optimize_job(*scene, *opts);
+    exit_if_interrupted(outcome);
+    const auto& dir = outcome.dir;
     render::RenderRequest req;
     req.run_dir = dir;
     req.backend = *backend;

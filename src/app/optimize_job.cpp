@@ -2,8 +2,6 @@
 
 #include <atomic>
 #include <csignal>
-#include <cstdio>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -14,6 +12,7 @@
 #include "core/error.h"
 #include "core/progress.h"
 #include "core/trajectory.h"
+#include "opt/controls_file.h"
 #include "opt/measures.h"
 #include "opt/optimizer.h"
 #include "sim/make_system.h"
@@ -28,105 +27,159 @@ namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop = true; }
 
-std::string format_record(const EvaluationRecord& r) {
+// Installs SIGINT/SIGTERM handlers for its lifetime.
+struct SignalGuard {
+  void (*old_int)(int), (*old_term)(int);
+  SignalGuard() {
+    g_stop = false;
+    old_int = std::signal(SIGINT, on_signal);
+    old_term = std::signal(SIGTERM, on_signal);
+  }
+  ~SignalGuard() {
+    std::signal(SIGINT, old_int);
+    std::signal(SIGTERM, old_term);
+  }
+};
+
+std::string format_record(int stage, const EvaluationRecord& r) {
   std::ostringstream os;
-  os << "eval " << std::setw(4) << r.evaluation << "  phi " << std::scientific << std::setprecision(4) << r.phi
-     << "  |g| " << r.grad_norm;
+  os << (stage > 0 ? "stage " + std::to_string(stage) + " " : "") << "eval " << std::setw(4) << r.evaluation
+     << "  phi " << std::scientific << std::setprecision(4) << r.phi << "  |g| " << r.grad_norm;
   for (const auto& [name, value] : r.terms) os << "  " << name << " " << value;
   os << std::fixed << std::setprecision(2) << "  " << r.seconds << " s" << (r.diverged ? "  (diverged)" : "");
   return os.str();
 }
 
-void write_history_csv(const fs::path& path, const OptimizeResult& res) {
+struct HistoryRow {
+  int stage, substeps;
+  double seconds;
+  EvaluationRecord rec;
+};
+
+void write_history_csv(const fs::path& path, const std::vector<HistoryRow>& rows,
+                       const std::vector<std::pair<std::string, double>>& names) {
   std::ostringstream os;
-  os << "evaluation,seconds,phi,grad_norm";
-  const auto& first = res.history.front().terms;
-  for (const auto& t : first) os << "," << t.first;
+  os << "evaluation,seconds,phi,grad_norm,stage,substeps";
+  for (const auto& t : names) os << "," << t.first;
   os << "\n" << std::setprecision(10);
-  for (const auto& r : res.history) {
-    os << r.evaluation << "," << r.seconds << "," << r.phi << "," << r.grad_norm;
-    for (size_t k = 0; k < first.size(); ++k) os << "," << (k < r.terms.size() && !r.diverged ? r.terms[k].second : NAN);
+  int k = 0;
+  for (const auto& r : rows) {
+    os << ++k << "," << r.seconds << "," << r.rec.phi << "," << r.rec.grad_norm << "," << r.stage << "," << r.substeps;
+    for (size_t i = 0; i < names.size(); ++i)
+      os << "," << (i < r.rec.terms.size() && !r.rec.diverged ? r.rec.terms[i].second : NAN);
     os << "\n";
   }
   write_file_atomic(path, os.str());
 }
 
-void save_controls(const fs::path& path, const VecX& z) {
-  write_stream_atomic(path, [&](std::ostream& out) {
-    const char magic[8] = {'K', 'F', 'C', 'T', 'R', 'L', '0', '1'};
-    const uint64_t n = uint64_t(z.size());
-    out.write(magic, 8);
-    out.write(reinterpret_cast<const char*>(&n), 8);
-    out.write(reinterpret_cast<const char*>(z.data()), std::streamsize(8 * n));
-  });
-}
-
 }  // namespace
 
-fs::path optimize_job(const fs::path& scene_file, const OptimizeOptions& opt) {
-  const Scene scene = load_scene(scene_file);
-  auto sys = make_system(scene);
-  const fs::path dir = run_dir_for(scene, opt.out);
-  Problem problem(scene, scene.time, *sys);
-  OptimizerSpec spec = scene.optimizer;
-  if (opt.max_evaluations >= 0) spec.max_evaluations = opt.max_evaluations;
-  prepare_run_dir(dir, scene);
+OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& opt) {
+  const bool resuming = !opt.resume.empty();
+  const Scene scene = resuming ? load_run_scene(opt.resume) : load_scene(scene_file);
+  const fs::path dir = resuming ? fs::path(opt.resume) : run_dir_for(scene, opt.out);
+
+  // The stages of coarse-to-fine continuation; a resumed run continues in the last stage.
+  std::vector<StageSpec> stages = scene.optimizer.schedule;
+  if (stages.empty()) stages.push_back({scene.time.substeps, scene.optimizer.max_evaluations});
+  if (opt.max_evaluations >= 0)
+    for (auto& s : stages) s.max_evaluations = opt.max_evaluations;
+  VecX z;
+  TimeSpec z_time = scene.time;
+  if (resuming) {
+    z = load_controls(dir / "controls.bin", &z_time.substeps);
+    stages.erase(stages.begin(), stages.end() - 1);
+  }
+  // Build the first system before writing anything, so bad scenes leave no trace.
+  TimeSpec time = scene.time;
+  time.substeps = stages[0].substeps;
+  auto sys = make_system(scene, time.h());
+  if (!resuming) prepare_run_dir(dir, scene);
 
   std::ostringstream log;
   auto say = [&](const std::string& line) {
     log << line << "\n";
     if (!opt.quiet) std::cout << line << std::endl;
   };
-  say("optimising " + scene.name + ": " + sys->describe() + ", " + std::to_string(scene.time.steps()) +
-      " steps, " + std::to_string(problem.size()) + " control variables (" + problem.controls().kind() + ")");
+  SignalGuard signals;
+  std::vector<HistoryRow> history;
+  double seconds_before = 0;
+  int evaluations = 0;
+  std::string status;
+  bool interrupted = false;
+  std::unique_ptr<Problem> problem;
+  OptimizeResult res;
+  for (size_t s = 0; s < stages.size() && !interrupted; ++s) {
+    time.substeps = stages[s].substeps;
+    if (s > 0) sys = make_system(scene, time.h());
+    problem = std::make_unique<Problem>(scene, time, *sys);
+    z = z.size() == 0 ? problem->initial_guess() : problem->controls().remap_from(z, z_time);
+    if (z.size() != problem->size())
+      throw InputError((dir / "controls.bin").string() + ": holds " + std::to_string(z.size()) +
+                       " controls, the scene needs " + std::to_string(problem->size()));
+    z_time = time;
+    const int stage_id = stages.size() > 1 ? int(s) + 1 : 0;
+    say(std::string(resuming ? "resuming " : "optimising ") + scene.name + (stage_id ? " stage " + std::to_string(stage_id) : "") +
+        ": " + sys->describe() + ", " + std::to_string(time.steps()) + " steps (h = " + std::to_string(time.h()) +
+        " s), " + std::to_string(problem->size()) + " control variables (" + problem->controls().kind() + ")");
+    OptimizerSpec spec = scene.optimizer;
+    spec.max_evaluations = stages[s].max_evaluations;
+    Progress progress("optimize " + scene.name, spec.max_evaluations);
+    res = minimize(*problem, spec, z,
+                   [&](const EvaluationRecord& r) {
+                     // Quiet runs show a progress line; others print every evaluation.
+                     log << format_record(stage_id, r) << "\n";
+                     if (opt.quiet) progress.update(r.evaluation);
+                     else std::cout << format_record(stage_id, r) << std::endl;
+                     history.push_back({stage_id, time.substeps, seconds_before + r.seconds, r});
+                   },
+                   &g_stop);
+    progress.finish();
+    z = res.z;
+    seconds_before += res.seconds;
+    evaluations += res.evaluations;
+    status = res.status;
+    interrupted = res.interrupted;
+  }
 
-  g_stop = false;
-  auto old_int = std::signal(SIGINT, on_signal);
-  auto old_term = std::signal(SIGTERM, on_signal);
-  Progress progress("optimize " + scene.name, spec.max_evaluations);
-  OptimizeResult res = minimize(problem, spec, problem.initial_guess(),
-                                [&](const EvaluationRecord& r) {
-                                  // Quiet runs show a progress line; others print every evaluation.
-                                  log << format_record(r) << "\n";
-                                  if (opt.quiet) progress.update(r.evaluation);
-                                  else std::cout << format_record(r) << std::endl;
-                                },
-                                &g_stop);
-  progress.finish();
-  std::signal(SIGINT, old_int);
-  std::signal(SIGTERM, old_term);
-
-  // Re-simulate the best point to get its states.
-  problem.evaluate(res.z, nullptr);
-  const Trajectory frames = frames_of(problem.rollout(), scene.time, sys->particles());
-  save_controls(dir / "controls.bin", res.z);
+  // Re-simulate the best point to get its states, then write everything.
+  problem->evaluate(z, nullptr);
+  const Trajectory frames = frames_of(problem->rollout(), time, sys->particles());
+  save_controls(dir / "controls.bin", z, time.substeps);
   save_trajectory(dir / "trajectory.bin", frames);
-  write_history_csv(dir / "iterations.csv", res);
-  plot_csv(dir / "iterations.csv", dir / "convergence.png", scene.name + ": objective and gradient norm", 1, {3, 4});
+  if (!history.empty()) {
+    write_history_csv(dir / "iterations.csv", history, history.front().rec.terms);
+    plot_csv(dir / "iterations.csv", dir / "convergence.png", scene.name + ": objective and gradient norm", 1, {3, 4});
+  }
   nlohmann::json report = {{"scene", scene.name},
                            {"command", "optimize"},
                            {"system", sys->describe()},
-                           {"controls", problem.controls().kind()},
-                           {"control_variables", problem.size()},
-                           {"steps", scene.time.steps()},
-                           {"status", res.status},
-                           {"interrupted", res.interrupted},
-                           {"evaluations", res.evaluations},
-                           {"wall_seconds", res.seconds},
-                           {"initial_objective", res.history.empty() ? 0.0 : res.history.front().phi},
-                           {"final_objective", res.phi},
+                           {"controls", problem->controls().kind()},
+                           {"control_variables", problem->size()},
+                           {"steps", time.steps()},
+                           {"substeps", time.substeps},
+                           {"stages", stages.size()},
+                           {"resumed", resuming},
+                           {"status", status},
+                           {"interrupted", interrupted},
+                           {"evaluations", evaluations},
+                           {"wall_seconds", seconds_before},
+                           {"initial_objective", history.empty() ? 0.0 : history.front().rec.phi},
+                           {"final_objective", problem->evaluate(z, nullptr)},
                            {"measures", figure_measures(scene, frames)}};
   nlohmann::json terms = nlohmann::json::object();
-  for (const auto& [name, value] : problem.breakdown()) terms[name] = value;
+  for (const auto& [name, value] : problem->breakdown()) terms[name] = value;
   report["final_terms"] = terms;
   write_json(dir / "report.json", report);
   std::ostringstream tail;
-  tail << res.status << " after " << res.evaluations << " evaluations in " << std::fixed << std::setprecision(2)
-       << res.seconds << " s; objective " << std::scientific << res.phi;
+  tail << status << " after " << evaluations << " evaluations in " << std::fixed << std::setprecision(2)
+       << seconds_before << " s; objective " << std::scientific << report["final_objective"].get<double>();
   say(tail.str());
-  write_file_atomic(dir / "log.txt", log.str());
-  if (res.interrupted) say("interrupted: best controls so far saved in " + (dir / "controls.bin").string());
-  return dir;
+  if (opt.quiet) std::cout << tail.str() << std::endl;
+  if (interrupted)
+    say("interrupted: best controls so far saved; continue with: keyframe optimize --resume " + dir.string());
+  write_file_atomic(dir / (resuming ? "log_resumed.txt" : "log.txt"), log.str());
+  return {dir, interrupted};
 }
 
 }  // namespace kf

@@ -7,11 +7,18 @@ namespace kf {
 
 struct OptimizeOptions {
   std::string out;            // run directory ("" = out/<scene>/)
-  int max_evaluations = -1;   // override the scene's limit when >= 0
+  int max_evaluations = -1;   // override the scene's limit (per stage) when >= 0
   bool quiet = false;         // no per-evaluation lines on stdout
+  std::string resume;         // run directory to continue from (its scene.json and controls.bin)
 };
 
-// Returns the run directory. Throws InputError/OutputError.
-std::filesystem::path optimize_job(const std::filesystem::path& scene_file, const OptimizeOptions& options);
+struct OptimizeOutcome {
+  std::filesystem::path dir;
+  bool interrupted = false;
+};
+
+// Throws InputError/OutputError. On SIGINT/SIGTERM it saves the best controls so far, writes the run
+// directory and returns with interrupted = true.
+OptimizeOutcome optimize_job(const std::filesystem::path& scene_file, const OptimizeOptions& options);
 
 }  // namespace kf

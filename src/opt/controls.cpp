@@ -3,7 +3,8 @@
 namespace kf {
 
 Controls::Controls(const ControlSpec& spec, const TimeSpec& time, int particles, bool planar, const VecX& v0_scene)
-    : kind_(spec.kind), alpha_(spec.alpha), steps_(time.steps()), substeps_(time.substeps), particles_(particles),
+    : kind_(spec.kind), alpha_(spec.alpha), steps_(time.steps()), substeps_(time.substeps), frames_(time.frames),
+      particles_(particles),
       h_(time.h()), v0_scene_(v0_scene) {
   comps_ = planar ? std::vector<int>{0, 2} : std::vector<int>{0, 1, 2};
   blocks_ = kind_ == "per_step" ? steps_ : kind_ == "per_frame" ? time.frames : 1;
@@ -52,6 +53,17 @@ void Controls::gather(const std::vector<VecX>& dU, const VecX& dv0, VecX& dz) co
     for (int i = 0; i < particles_; ++i)
       for (int c = 0; c < nc; ++c) dz[b * stride + i * nc + c] += dU[n][3 * i + comps_[c]];
   }
+}
+
+VecX Controls::remap_from(const VecX& z, const TimeSpec& from) const {
+  if (kind_ != "per_step" || from.substeps == substeps_) return z;
+  const int stride = particles_ * int(comps_.size());
+  VecX out(size());
+  for (int n = 0; n < steps_; ++n) {
+    const int m = std::min(from.steps() - 1, int((long(n) * from.substeps) / substeps_));
+    out.segment(long(n) * stride, stride) = z.segment(long(m) * stride, stride);
+  }
+  return out;
 }
 
 double Controls::effort(const VecX& z, VecX& dz) const {

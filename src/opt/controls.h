@@ -23,13 +23,16 @@ class Controls {
   void expand(const VecX& z, VecX& v0, std::vector<VecX>& U) const;
   // Chain rule back: dphi/dU and dphi/dv0 -> dphi/dz (overwrites dz).
   void gather(const std::vector<VecX>& dU, const VecX& dv0, VecX& dz) const;
+  // Carries controls made for `from` (another substep count) over to this parameterisation: per-frame
+  // and initial-velocity controls are unchanged; per-step forces are held over the nearest coarse step.
+  VecX remap_from(const VecX& z, const TimeSpec& from) const;
   // Control effort ½α∫‖u‖²dt (forces) or ½α‖v0 − v0_scene‖² (initial velocities); adds its gradient.
   double effort(const VecX& z, VecX& dz) const;
 
  private:
   std::string kind_;
   double alpha_;
-  int steps_, substeps_, particles_, blocks_;
+  int steps_, substeps_, frames_, particles_, blocks_;
   double h_;
   std::vector<int> comps_;  // which of x, y, z are controlled
   VecX v0_scene_;

@@ -26,11 +26,18 @@ struct ControlSpec {
   double alpha = 1e-4;            // weight of the control effort ½α‖u‖²
 };
 
+// One stage of coarse-to-fine continuation: optimise at this many substeps per frame.
+struct StageSpec {
+  int substeps = 1;
+  int max_evaluations = 100;
+};
+
 struct OptimizerSpec {
   int max_evaluations = 300;  // each one forward + one adjoint pass
   double ftol_rel = 1e-8;
   double max_seconds = 0;  // 0: no limit
   int memory = 10;         // L-BFGS vectors
+  std::vector<StageSpec> schedule;  // empty: one stage at the scene's substeps
 };
 
 }  // namespace kf

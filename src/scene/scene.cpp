@@ -73,6 +73,13 @@ OptimizerSpec parse_optimizer(Block b) {
   o.ftol_rel = b.number("ftol_rel", o.ftol_rel, 0.0, 1.0);
   o.max_seconds = b.number("max_seconds", o.max_seconds, 0.0, 1e7);
   o.memory = b.integer("memory", o.memory, 1, 100);
+  for (Block& stage : b.array("schedule")) {
+    StageSpec st;
+    st.substeps = stage.integer("substeps", 1, 10000);
+    st.max_evaluations = stage.integer("max_evaluations", st.max_evaluations, 0, 1000000);
+    stage.finish();
+    o.schedule.push_back(st);
+  }
   b.finish();
   return o;
 }
