@@ -48,6 +48,7 @@ void add_simulate_command(CLI::App& app) {
     nlohmann::json report = {{"scene", scene.name}, {"command", "simulate"}, {"system", sys->describe()},
                              {"steps", scene.time.steps()}, {"frames", scene.time.frames + 1},
                              {"simulate_seconds", secs}};
+    for (const auto& [name, value] : sys->run_stats()) report["run_stats"][name] = value;
     write_json(dir / "report.json", report);
     std::cout << "simulated " << scene.time.steps() << " steps of " << sys->describe() << " in " << secs
               << " s -> " << (dir / "trajectory.bin").string() << "\n";

@@ -170,6 +170,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   nlohmann::json terms = nlohmann::json::object();
   for (const auto& [name, value] : problem->breakdown()) terms[name] = value;
   report["final_terms"] = terms;
+  for (const auto& [name, value] : sys->run_stats()) report["run_stats"][name] = value;
   write_json(dir / "report.json", report);
   std::ostringstream tail;
   tail << status << " after " << evaluations << " evaluations in " << std::fixed << std::setprecision(2)

@@ -116,6 +116,7 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& file) {
     Block b = root.child("cloth");
     s.cloth = parse_cloth_spec(b);
   }
+  if (root.has("character")) s.character = parse_character_spec(root.child("character"), s);
   for (Block& b : root.array("objectives")) s.objectives.push_back(parse_objective(std::move(b), s));
   s.controls = parse_controls(root.child("controls"), s);
   s.optimizer = parse_optimizer(root.child("optimizer"));

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "scene/character_spec.h"
 #include "scene/cloth_spec.h"
 #include "scene/flock_spec.h"
 #include "scene/objective_spec.h"
@@ -25,6 +26,7 @@ struct Scene {
   ControlSpec controls;
   OptimizerSpec optimizer;
   RenderSpec render;
+  std::optional<CharacterSpec> character;  // a cape's character (cloth scenes only)
   int particles() const;
 };
 

@@ -13,5 +13,6 @@ std::unique_ptr<System> make_system(const Scene& scene, double h_override = 0);
 // Implemented by each family.
 std::unique_ptr<System> make_flock_system(const Scene& scene, double h);
 std::unique_ptr<System> make_cloth_system(const Scene& scene, double h);
+std::unique_ptr<System> make_cape_system(const Scene& scene, double h);
 
 }  // namespace kf

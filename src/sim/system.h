@@ -5,6 +5,8 @@
 // Controls: an external force u_n (3p, newtons) applied during step n (n = 0 .. steps-1).
 // The step length h is fixed when the system is built from a scene.
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/types.h"
 
@@ -39,6 +41,9 @@ class System {
 
   // One-line description for logs ("flock: 200 agents, grid neighbour search").
   virtual std::string describe() const = 0;
+
+  // Named counters of the last forward simulation for run reports (a cape's collision contacts).
+  virtual std::vector<std::pair<std::string, double>> run_stats() const { return {}; }
 };
 
 }  // namespace kf

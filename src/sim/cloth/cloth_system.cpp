@@ -19,7 +19,8 @@ constexpr int kSpringGrain = 1024;
 constexpr int kParticleGrain = 256;
 }  // namespace
 
-ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTrack> pins)
+ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTrack> pins,
+                         std::vector<std::unique_ptr<Collider>> extra_colliders)
     : spec_(spec), p_(spec.particles()), h_(h), pins_(pins ? std::move(pins) : std::make_unique<StaticPins>()) {
   const int nx = spec.nx, ny = spec.ny;
   const double dx = spec.width / (nx - 1), dy = spec.height / (ny - 1);
@@ -79,6 +80,7 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   }
 
   colliders_ = make_colliders(spec.colliders);
+  for (auto& c : extra_colliders) colliders_.push_back(std::move(c));
   free_.assign(p_, 1);
   for (int i : spec.pins) {
     if (i < 0 || i >= p_) throw InputError("cloth: pinned particle " + std::to_string(i) + " does not exist");

@@ -29,8 +29,10 @@ namespace kf {
 
 class ClothSystem final : public System {
  public:
-  // h: step length, s. `pins` defaults to StaticPins.
-  ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTrack> pins = nullptr);
+  // h: step length, s. `pins` defaults to StaticPins. `extra_colliders` act after the spec's colliders
+  // (a character's body, self-collision); callers that update them per step keep raw pointers.
+  ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTrack> pins = nullptr,
+              std::vector<std::unique_ptr<Collider>> extra_colliders = {});
 
   int particles() const override { return p_; }
   double h() const override { return h_; }

@@ -1,0 +1,94 @@
+#include "scene/character_spec.h"
+
+#include <algorithm>
+
+#include "core/error.h"
+#include "core/trajectory.h"
+#include "scene/params.h"
+#include "scene/scene.h"
+
+namespace kf {
+
+double animation_time(const CharacterSpec& spec, double frame) {
+  const auto& k = spec.time_keys;
+  if (frame <= k.front().x()) return k.front().y();
+  for (size_t i = 1; i < k.size(); ++i)
+    if (frame <= k[i].x()) {
+      const double s = (frame - k[i - 1].x()) / (k[i].x() - k[i - 1].x());
+      return k[i - 1].y() + s * (k[i].y() - k[i - 1].y());
+    }
+  return k.back().y();
+}
+
+namespace {
+
+// One frame of a run's trajectory, checked against the cape's particle count.
+void load_run_state(Block& b, const std::filesystem::path& run, int frame, int particles, VecX& x, VecX& v) {
+  const Trajectory t = load_trajectory(run / "trajectory.bin");
+  if (t.particles != particles)
+    b.fail("run", "expected a run of " + std::to_string(particles) + " particles, got " + std::to_string(t.particles));
+  if (frame >= t.frames())
+    b.fail("frame", "expected a frame below " + std::to_string(t.frames()) + " (the run's length)");
+  x = t.x[frame];
+  v = t.v[frame];
+}
+
+}  // namespace
+
+CharacterSpec parse_character_spec(Block b, Scene& scene) {
+  if (!scene.cloth) b.fail_here("expected a \"cloth\" block for the cape (a character needs a cloth)");
+  CharacterSpec c;
+  const int p = scene.particles();
+  c.file = scene.directory / b.string("file");
+  c.animation = b.integer("animation", 0, 0, 1000);
+  if (b.has("time")) {
+    c.time_keys = b.points2("time", 1, -1e6, 1e6);
+    for (size_t i = 1; i < c.time_keys.size(); ++i)
+      if (!(c.time_keys[i].x() > c.time_keys[i - 1].x()))
+        b.fail_rel("/time/" + std::to_string(i), "expected frames in ascending order");
+  }
+  c.offset = b.vec3("offset", Vec3::Zero());
+  {
+    Block body = b.child("body");
+    c.body_thickness = body.number("thickness", c.body_thickness, 1e-5, 1.0);
+    c.body_stiffness = body.number("stiffness", c.body_stiffness, 0.0, 1e8);
+    c.body_search = body.number("search", c.body_search, 0.0, 1.0);
+    body.finish();
+  }
+  {
+    Block self = b.child("self");
+    c.self_collision = self.boolean("enabled", c.self_collision);
+    c.self_thickness = self.number("thickness", c.self_thickness, 1e-5, 1.0);
+    c.self_stiffness = self.number("stiffness", c.self_stiffness, 0.0, 1e8);
+    self.finish();
+  }
+  if (auto start = b.optional_child("start")) {
+    c.start_run = scene.directory / start->string("run");
+    c.start_frame = start->integer("frame", 0, 0, 1'000'000);
+    load_run_state(*start, c.start_run, c.start_frame, p, c.start_x, c.start_v);
+    start->finish();
+  }
+  if (auto end = b.optional_child("end_target")) {
+    c.target_run = scene.directory / end->string("run");
+    c.target_frame = end->integer("frame", 0, 0, 1'000'000);
+    const double wx = end->number("position_weight", 1.0, 0.0, 1e12);
+    const double wv = end->number("velocity_weight", 0.01, 0.0, 1e12);
+    VecX x, v;
+    load_run_state(*end, c.target_run, c.target_frame, p, x, v);
+    end->finish();
+    ObjectiveSpec o;
+    o.frame = scene.time.frames;
+    for (int i = 0; i < p; ++i) o.targets.push_back(seg(x, i));
+    o.type = "position";
+    o.weight = wx;
+    scene.objectives.push_back(o);
+    o.type = "velocity";
+    o.weight = wv;
+    for (int i = 0; i < p; ++i) o.targets[i] = seg(v, i);
+    scene.objectives.push_back(o);
+  }
+  b.finish();
+  return c;
+}
+
+}  // namespace kf

@@ -1,0 +1,55 @@
+#pragma once
+// The animated character a cape hangs from, as the scene file states it, with the time remap of its
+// animation and the run directories that give the cape's start state and end targets.
+//
+// Scene block (every key optional except "file"):
+//   "character": {
+//     "file": "../assets/character/BCN_Epileptic.X",   // relative to the scene file's directory
+//     "animation": 0,
+//     "time": [[0, 0.3], [30, 1.9]],   // (frame, animation seconds) keys, frames ascending; piecewise
+//                                      // linear between keys, held before the first and after the last
+//     "offset": [0, 0, 0],             // world-from-file translation, metres
+//     "body": {"thickness": 0.012, "stiffness": 2000, "search": 0.06},
+//     "self": {"enabled": true, "thickness": 0.01, "stiffness": 500},
+//     "start": {"run": "../out/cape-a", "frame": 39},             // initial cape state (x and v)
+//     "end_target": {"run": "../out/cape-b", "frame": 51,          // adds "position" and "velocity"
+//                    "position_weight": 1, "velocity_weight": 0.01} // objectives at the last frame
+//   }
+// The cloth block describes the cape; its top edge is pinned to the shoulder anchors whatever "pins" says.
+#include <filesystem>
+#include <optional>
+
+#include "core/types.h"
+
+namespace kf {
+class Block;
+struct Scene;
+
+struct CharacterSpec {
+  std::filesystem::path file;        // resolved against the scene's directory
+  int animation = 0;
+  std::vector<Vec2> time_keys{{0.0, 0.0}};  // (frame, seconds)
+  Vec3 offset = Vec3::Zero();        // metres
+  double body_thickness = 0.012;     // m: contact springs act within this distance of the body
+  double body_stiffness = 2000.0;    // N/m
+  double body_search = 0.06;         // m: particles deeper than this inside the body get no force
+  bool self_collision = true;
+  double self_thickness = 0.01;      // m: particle pairs closer than this repel
+  double self_stiffness = 500.0;     // N/m
+  // Start state from a run's trajectory (empty x: the cloth block's flat layout).
+  std::filesystem::path start_run;
+  int start_frame = 0;
+  VecX start_x, start_v;             // 3p each
+  // End target from a run's trajectory (empty path: none).
+  std::filesystem::path target_run;
+  int target_frame = 0;
+};
+
+// Animation time (seconds) at a (fractional) frame of the scene, by the spec's keys.
+double animation_time(const CharacterSpec& spec, double frame);
+
+// Reads the "character" block of a scene that already has its cloth and time; loads the start state and
+// appends the end-target objectives to scene.objectives. Throws InputError with the key's JSON pointer.
+CharacterSpec parse_character_spec(Block b, Scene& scene);
+
+}  // namespace kf

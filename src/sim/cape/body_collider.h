@@ -1,0 +1,41 @@
+#pragma once
+// The animated character's body as a cloth collider: a repulsive spring along the outward normal of the
+// closest body point, k (thickness - phi) n, when the signed distance phi is below `thickness`.
+//
+// The pose is set from outside once per step (set_pose refits the BVH), so contact() only reads.
+#include <atomic>
+
+#include "sim/character/body_query.h"
+#include "sim/cloth/collider.h"
+
+namespace kf {
+
+class BodyCollider final : public Collider {
+ public:
+  // triangles: #T by 3 indices into vertex_count body vertices. thickness, search: metres; stiffness: N/m.
+  // A particle more than `search` metres inside the body gets no force (the open shells' inside is a guess
+  // far from the surface).
+  BodyCollider(const TriangleIndices& triangles, int vertex_count, double thickness, double stiffness,
+               double search);
+
+  // New body pose: 3n vertex positions, metres, world frame. Allocation-free after the first call.
+  void set_pose(const VecX& vertices) { query_.update(vertices); }
+
+  // f = k (thickness - phi) n; df/dx = -k n n^T, plus k (thickness - phi) dn/dx unless `definite`
+  // (dn/dx is zero on a face and sign (I - n n^T) / distance on an edge or a vertex). df/dv = 0.
+  bool contact(int n, const Vec3& x, const Vec3& v, bool definite, ContactForce& out) const override;
+
+  // While counting is on, every contact() that finds a contact adds one to the counter.
+  void set_counting(bool on) { counting_ = on; }
+  int take_count() { return count_.exchange(0); }
+
+  const BodyQuery& query() const { return query_; }
+
+ private:
+  BodyQuery query_;
+  double thickness_, stiffness_, search_;
+  bool counting_ = false;
+  mutable std::atomic<int> count_{0};
+};
+
+}  // namespace kf

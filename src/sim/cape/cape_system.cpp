@@ -1,0 +1,143 @@
+#include "sim/cape/cape_system.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "sim/cape/anchor_track.h"
+#include "sim/character/cape_anchors.h"
+#include "sim/make_system.h"
+
+namespace kf {
+
+namespace {
+
+CharacterOptions character_options(const CharacterSpec& s) {
+  CharacterOptions o;
+  o.animation = s.animation;
+  o.wrap = TimeWrap::kClamp;
+  o.placement = Affine(Eigen::Translation3d(s.offset));
+  return o;
+}
+
+}  // namespace
+
+CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, double fps, int steps, double h)
+    : spec_(character), fps_(fps), h_(h), character_(character.file, character_options(character)),
+      cape_length_(cloth.height) {
+  ClothSpec c = cloth;
+  c.pins = named_pin_set("top_edge", c.nx, c.ny);
+  std::vector<double> params;
+  for (int k = 0; k < int(c.pins.size()); ++k) params.push_back(c.nx > 1 ? double(k) / (c.nx - 1) : 0.5);
+
+  // The pins' path over the whole run (one pose per step, plus one past the end for the last velocity).
+  const std::vector<int> anchor_ids = cape_anchor_vertices(character_);
+  std::vector<std::vector<Vec3>> anchors;
+  VecX gathered;
+  for (int n = 0; n <= steps + 1; ++n) {
+    character_.pose(animation_time_at(n), pose_);
+    gather_vertices(pose_, anchor_ids, gathered);
+    std::vector<Vec3> a(anchor_ids.size());
+    for (size_t k = 0; k < a.size(); ++k) a[k] = seg(gathered, int(k));
+    anchors.push_back(std::move(a));
+  }
+  auto track = std::make_unique<AnchorTrack>(anchors, c.pins, params, c.particles(), h);
+
+  std::vector<std::unique_ptr<Collider>> extra;
+  auto body = std::make_unique<BodyCollider>(character_.triangles(), character_.vertex_count(),
+                                             spec_.body_thickness, spec_.body_stiffness, spec_.body_search);
+  body_ = body.get();
+  extra.push_back(std::move(body));
+  if (spec_.self_collision) {
+    auto self = std::make_unique<SelfCollider>(c.particles(), spec_.self_thickness, spec_.self_stiffness);
+    self_ = self.get();
+    extra.push_back(std::move(self));
+  }
+  cloth_ = std::make_unique<ClothSystem>(c, h, std::move(track), std::move(extra));
+  w_.setZero(3 * c.particles());
+}
+
+double CapeSystem::animation_time_at(int n) const { return animation_time(spec_, n * h_ * fps_); }
+
+VecX CapeSystem::body_at(int n) {
+  VecX out;
+  character_.pose(animation_time_at(n), out);
+  return out;
+}
+
+void CapeSystem::initial_state(VecX& x, VecX& v) const {
+  cloth_->initial_state(x, v);
+  if (spec_.start_x.size() != x.size()) return;
+  for (int i = 0; i < particles(); ++i)
+    if (!cloth_->pinned(i)) {
+      seg(x, i) = seg(spec_.start_x, i);
+      seg(v, i) = seg(spec_.start_v, i);
+    }
+}
+
+void CapeSystem::prepare(int n, const VecX& x) {
+  if (posed_step_ != n) {
+    character_.pose(animation_time_at(n), pose_);
+    body_->set_pose(pose_);
+    posed_step_ = n;
+  }
+  if (self_) self_->update(x);
+}
+
+bool CapeSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) {
+  prepare(n, x);
+  if (n == 0) {
+    body_contacts_ = self_contacts_ = 0;
+    max_body_ = max_self_ = contact_steps_ = 0;
+  }
+  body_->take_count();
+  body_->set_counting(true);
+  if (self_) {
+    self_->take_count();
+    self_->set_counting(true);
+  }
+  const bool ok = cloth_->step(n, x, v, u, x_next, v_next);
+  body_->set_counting(false);
+  const int nb = body_->take_count();
+  int ns = 0;
+  if (self_) {
+    self_->set_counting(false);
+    ns = self_->take_count() / 2;
+  }
+  body_contacts_ += nb;
+  self_contacts_ += ns;
+  max_body_ = std::max(max_body_, nb);
+  max_self_ = std::max(max_self_, ns);
+  contact_steps_ += (nb + ns) > 0;
+  return ok;
+}
+
+void CapeSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const VecX& xhat1,
+                              const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) {
+  prepare(n, x);
+  cloth_->step_adjoint(n, x, v, u, xhat1, vhat1, xhat, vhat, uhat);
+  if (self_) {
+    w_ = uhat / h_;  // the cloth's uhat is h w
+    self_->add_cross_adjoint(w_, h_, xhat);
+  }
+}
+
+std::string CapeSystem::describe() const {
+  std::ostringstream os;
+  os << "cape on " << spec_.file.filename().string() << " (" << character_.triangle_count()
+     << " body triangles, self-collision " << (self_ ? "on" : "off") << "); " << cloth_->describe();
+  return os.str();
+}
+
+std::vector<std::pair<std::string, double>> CapeSystem::run_stats() const {
+  return {{"body_contacts", double(body_contacts_)}, {"self_contacts", double(self_contacts_)},
+          {"max_body_contacts", double(max_body_)},  {"max_self_contacts", double(max_self_)},
+          {"contact_steps", double(contact_steps_)}, {"cape_length", cape_length_}};
+}
+
+std::unique_ptr<System> make_cape_system(const Scene& scene, double h) {
+  const int steps = int(std::llround(scene.time.duration() / h));
+  return std::make_unique<CapeSystem>(*scene.cloth, *scene.character, scene.time.fps, steps, h);
+}
+
+}  // namespace kf

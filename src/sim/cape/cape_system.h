@@ -1,0 +1,65 @@
+#pragma once
+// A cape on an animated character (paper figure 6): a Choi-Ko cloth whose top edge follows the skinned
+// shoulder anchors, pushed out of the moving body mesh and out of itself, inside the step and its adjoint.
+//
+// Step n uses the body posed at animation time animation_time(spec, n h fps) and a spatial hash of x_n.
+// Backward: the cloth's adjoint (body contact exact in K^T w) plus the self-contact cross blocks of
+// K^T w (SelfCollider::add_cross_adjoint with w = uhat / h).
+#include <memory>
+#include <vector>
+
+#include "scene/character_spec.h"
+#include "scene/cloth_spec.h"
+#include "sim/cape/body_collider.h"
+#include "sim/cape/self_collider.h"
+#include "sim/character/character.h"
+#include "sim/cloth/cloth_system.h"
+
+namespace kf {
+
+class CapeSystem final : public System {
+ public:
+  // cloth: the cape (its top edge is pinned to the anchors whatever cloth.pins says); fps: frames per
+  // second of the scene (for the time remap); steps: how many steps the run has (poses precomputed for
+  // the pins); h: step length, s. Throws InputError when the character file cannot be loaded.
+  CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, double fps, int steps, double h);
+
+  int particles() const override { return cloth_->particles(); }
+  double h() const override { return h_; }
+  const VecX& masses() const override { return cloth_->masses(); }
+  // The start run's state when the scene names one (pinned particles moved onto the anchors), else the
+  // cloth block's flat layout.
+  void initial_state(VecX& x, VecX& v) const override;
+  bool step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) override;
+  void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const VecX& xhat1, const VecX& vhat1,
+                    VecX& xhat, VecX& vhat, VecX& uhat) override;
+  std::string describe() const override;
+  // Contacts of the last forward run: body_contacts (particle-steps), self_contacts (pair-steps),
+  // max_body_contacts / max_self_contacts (in one step), contact_steps, cape_length (m).
+  std::vector<std::pair<std::string, double>> run_stats() const override;
+
+  // Animation time (s) of step n and the posed body (3n vertices) at that step (allocates).
+  double animation_time_at(int n) const;
+  VecX body_at(int n);
+  Character& character() { return character_; }
+  ClothSystem& cloth() { return *cloth_; }
+  const SelfCollider& self_collider() const { return *self_; }
+
+ private:
+  void prepare(int n, const VecX& x);  // body at step n, self hash of x
+
+  CharacterSpec spec_;
+  double fps_, h_;
+  Character character_;
+  VecX pose_;
+  int posed_step_ = -1;
+  BodyCollider* body_ = nullptr;  // owned by cloth_
+  SelfCollider* self_ = nullptr;  // owned by cloth_; null when self-collision is off
+  std::unique_ptr<ClothSystem> cloth_;
+  VecX w_;
+  double cape_length_;
+  long body_contacts_ = 0, self_contacts_ = 0;
+  int max_body_ = 0, max_self_ = 0, contact_steps_ = 0;
+};
+
+}  // namespace kf

@@ -1,0 +1,79 @@
+#include "sim/cape/self_collider.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace kf {
+
+SelfCollider::SelfCollider(int particles, double thickness, double stiffness)
+    : p_(particles), thickness_(thickness), stiffness_(stiffness), x_(VecX::Zero(3 * particles)), cells_(particles) {}
+
+int64_t SelfCollider::key_of(const Vec3& x, int dx, int dy, int dz) const {
+  // 21 bits per axis; wrapping far away only adds candidates that the distance test rejects.
+  auto c = [&](double a, int d) { return (int64_t(std::floor(a / thickness_)) + d) & 0x1FFFFF; };
+  return (c(x.x(), dx) << 42) | (c(x.y(), dy) << 21) | c(x.z(), dz);
+}
+
+void SelfCollider::update(const VecX& x) {
+  x_ = x;
+  for (int i = 0; i < p_; ++i) cells_[i] = {key_of(seg(x, i), 0, 0, 0), i};
+  std::sort(cells_.begin(), cells_.end());
+}
+
+template <class Visit>
+void SelfCollider::for_each_near(const Vec3& x, Visit&& visit) const {
+  const double t2 = thickness_ * thickness_;
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz) {
+        const int64_t key = key_of(x, dx, dy, dz);
+        auto it = std::lower_bound(cells_.begin(), cells_.end(), std::make_pair(key, -1));
+        for (; it != cells_.end() && it->first == key; ++it) {
+          const Vec3 d = x - seg(x_, it->second);
+          const double r2 = d.squaredNorm();
+          if (r2 == 0.0 || r2 >= t2) continue;  // the particle itself, or out of reach
+          visit(it->second, d);
+        }
+      }
+}
+
+Mat3 SelfCollider::pair_jacobian(const Vec3& d, bool definite) const {
+  const double r = d.norm();
+  const Vec3 n = d / r;
+  Mat3 J = -stiffness_ * n * n.transpose();
+  if (!definite) J += stiffness_ * (thickness_ - r) / r * (Mat3::Identity() - n * n.transpose());
+  return J;
+}
+
+bool SelfCollider::contact(int, const Vec3& x, const Vec3&, bool definite, ContactForce& out) const {
+  int found = 0;
+  Vec3 f = Vec3::Zero();
+  Mat3 K = Mat3::Zero();
+  for_each_near(x, [&](int, const Vec3& d) {
+    const double r = d.norm();
+    f += stiffness_ * (thickness_ - r) / r * d;
+    K += pair_jacobian(d, definite);
+    ++found;
+  });
+  if (!found) return false;
+  out.f = f;
+  out.dfdx = K;
+  out.dfdv.setZero();
+  if (counting_) count_.fetch_add(found, std::memory_order_relaxed);
+  return true;
+}
+
+void SelfCollider::add_cross_adjoint(const VecX& w, double h, VecX& xhat) const {
+  tbb::parallel_for(tbb::blocked_range<int>(0, p_, 128), [&](const tbb::blocked_range<int>& r) {
+    for (int i = r.begin(); i < r.end(); ++i) {
+      Vec3 acc = Vec3::Zero();
+      for_each_near(seg(x_, i), [&](int j, const Vec3& d) { acc -= pair_jacobian(d, false) * seg(w, j); });
+      seg(xhat, i) += h * acc;
+    }
+  });
+}
+
+}  // namespace kf

@@ -1,0 +1,55 @@
+#pragma once
+// Cloth self-collision: particle pairs closer than `thickness` repel with a spring k (thickness - r) along
+// the line between them (energy ½k(thickness - r)^2), found through a spatial hash rebuilt per state.
+//
+// It fits the per-particle Collider interface as a gather: the contact of particle i sums its pairs and
+// gives d f_i / d x_i. The cross blocks d f_i / d x_j (= -d f_i / d x_i of that pair) cannot go through
+// that interface; the cloth's implicit matrix A leaves them out in both passes (like a block-Jacobi
+// stiffness), and add_cross_adjoint puts them into the adjoint's K^T w so xhat uses the exact Jacobian.
+#include <atomic>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "sim/cloth/collider.h"
+
+namespace kf {
+
+class SelfCollider final : public Collider {
+ public:
+  // particles: p; thickness: metres; stiffness: N/m.
+  SelfCollider(int particles, double thickness, double stiffness);
+
+  // Positions of the state the next contact() calls see (3p, metres). Allocation-free.
+  void update(const VecX& x);
+
+  // Sums the pairs of the particle at x (it must be one of the updated positions; the particle itself is
+  // recognised by its identical position). df/dx: per pair -k n n^T, plus k (thickness - r)/r (I - n n^T)
+  // unless `definite`.
+  bool contact(int n, const Vec3& x, const Vec3& v, bool definite, ContactForce& out) const override;
+
+  // xhat_i += h * sum_j (d f_j / d x_i)^T w_j = -h * sum_j J_ij w_j over the pairs of the updated state
+  // (w, xhat: 3p). Parallel per particle i, each writing only its own entries.
+  void add_cross_adjoint(const VecX& w, double h, VecX& xhat) const;
+
+  // Pair Jacobian J = d f_i / d x_i of one pair with offset d = x_i - x_j (|d| < thickness).
+  Mat3 pair_jacobian(const Vec3& d, bool definite) const;
+
+  void set_counting(bool on) { counting_ = on; }
+  // Particle contacts counted since the last take (each pair counts twice).
+  int take_count() { return count_.exchange(0); }
+
+ private:
+  int64_t key_of(const Vec3& x, int dx, int dy, int dz) const;
+  template <class Visit>
+  void for_each_near(const Vec3& x, Visit&& visit) const;
+
+  int p_;
+  double thickness_, stiffness_;
+  VecX x_;
+  std::vector<std::pair<int64_t, int>> cells_;  // (cell key, particle), sorted
+  bool counting_ = false;
+  mutable std::atomic<int> count_{0};
+};
+
+}  // namespace kf
