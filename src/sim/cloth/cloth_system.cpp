@@ -19,7 +19,8 @@ constexpr int kSpringGrain = 1024;
 constexpr int kParticleGrain = 256;
 }  // namespace
 
-ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTrack> pins)
+ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTrack> pins,
+                         std::vector<std::unique_ptr<Collider>> extra_colliders)
     : spec_(spec), p_(spec.particles()), h_(h), pins_(pins ? std::move(pins) : std::make_unique<StaticPins>()) {
   const int nx = spec.nx, ny = spec.ny;
   const double dx = spec.width / (nx - 1), dy = spec.height / (ny - 1);
@@ -79,6 +80,7 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   }
 
   colliders_ = make_colliders(spec.colliders);
+  for (auto& c : extra_colliders) colliders_.push_back(std::move(c));
   free_.assign(p_, 1);
   for (int i : spec.pins) {
     if (i < 0 || i >= p_) throw InputError("cloth: pinned particle " + std::to_string(i) + " does not exist");
@@ -96,7 +98,8 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   kv_.setZero(3 * p_);
   aw_.setZero(3 * p_);
   w_.setZero(3 * p_);
-  pcg_.resize(p_);
+  pcg_.resize(p_, spec.cg_preconditioner == "block_jacobi" ? Preconditioner::kBlockJacobi
+                                                           : Preconditioner::kIncompleteCholesky);
 }
 
 void ClothSystem::initial_state(VecX& x, VecX& v) const {
@@ -239,7 +242,8 @@ void ClothSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& 
 std::string ClothSystem::describe() const {
   std::ostringstream os;
   os << "cloth: " << spec_.nx << "x" << spec_.ny << " particles, " << springs_.size() << " springs, "
-     << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, block-Jacobi PCG";
+     << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, PCG ("
+     << spec_.cg_preconditioner << ")";
   return os.str();
 }
 

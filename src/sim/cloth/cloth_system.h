@@ -1,7 +1,7 @@
 #pragma once
 // Choi-Ko cloth stepped by linearised backward Euler (design §4), with its approximate adjoint.
 //
-// Forward:  A dv = b, A = M - h D - h^2 K, b = h (f + h K v + u), solved by block-Jacobi PCG with pinned
+// Forward:  A dv = b, A = M - h D - h^2 K, b = h (f + h K v + u), solved by PCG (IC(0)) with pinned
 //           particles filtered out (Baraff-Witkin); v1 = v + dv, x1 = x + h v1.
 // Backward: A^T w = vhat1 + h xhat1 on the free set, vhat = M w, xhat = xhat1 + h K^T w, uhat = h w.
 // In A (both passes) K is the springs' definite stiffness (compressive transverse part dropped) plus the
@@ -29,8 +29,10 @@ namespace kf {
 
 class ClothSystem final : public System {
  public:
-  // h: step length, s. `pins` defaults to StaticPins.
-  ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTrack> pins = nullptr);
+  // h: step length, s. `pins` defaults to StaticPins. `extra_colliders` act after the spec's colliders
+  // (e.g. a character mesh that is not described by the cloth spec).
+  ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTrack> pins = nullptr,
+              std::vector<std::unique_ptr<Collider>> extra_colliders = {});
 
   int particles() const override { return p_; }
   double h() const override { return h_; }
