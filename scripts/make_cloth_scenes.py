@@ -33,7 +33,7 @@ for j in range(n):
         scoop.append(r4([x, top - R * math.sin(th), -(R - R * math.cos(th))]))
 dump("scenes/shapes.json", {
     "seed": 1,
-    "time": {"fps": 30, "substeps": 2, "frames": 45},
+    "time": {"fps": 30, "substeps": 4, "frames": 45},
     "cloth": {"nx": n, "ny": n, "width": size, "height": size, "origin": [-0.5, top - size, 0],
               "u_axis": [1, 0, 0], "v_axis": [0, 1, 0], "mass": 0.3, "pins": "top_edge",
               "cg_tolerance": 1e-6},
@@ -42,7 +42,7 @@ dump("scenes/shapes.json", {
         {"type": "position", "frame": 45, "weight": 100, "targets": scoop},
     ],
     "controls": {"kind": "per_frame", "alpha": 1e-5},
-    "optimizer": {"max_evaluations": 200, "ftol_rel": 1e-9},
+    "optimizer": {"max_evaluations": 60, "ftol_rel": 1e-9},
     "render": {"camera": {"eye": [2.6, 2.0, 2.6], "target": [0, 1.0, 0]}},
 })
 

@@ -47,15 +47,16 @@ Outcome optimise(const Scene& scene) {
 }
 
 TEST(ClothFigures, ArchReachesTheCylinderWithinOnePercentOfTheWidth) {
+  // Weightless and in free space, as scenes/arch.json; h = 1/120 s, where the approximate adjoint is
+  // accurate enough for the line search to keep making progress (at 1/30 it stalls near 2 %).
   const Scene scene = parse_scene(R"({
-    "time": {"fps": 30, "substeps": 2, "frames": 20},
-    "cloth": {"nx": 10, "ny": 10, "width": 1.0, "height": 1.0, "origin": [-0.5, 0.02, -0.5],
-              "u_axis": [1, 0, 0], "v_axis": [0, 0, 1], "mass": 0.5, "cg_tolerance": 1e-10,
-              "colliders": [{"type": "ground", "center": [0, 0, 0], "axis": [0, 1, 0]}]},
+    "time": {"fps": 30, "substeps": 4, "frames": 20},
+    "cloth": {"nx": 10, "ny": 10, "width": 1.0, "height": 1.0, "origin": [-0.5, 0, -0.5],
+              "u_axis": [1, 0, 0], "v_axis": [0, 0, 1], "mass": 0.5, "gravity": [0, 0, 0], "cg_tolerance": 1e-10},
     "objectives": [{"type": "arch", "frame": 20, "weight": 100, "axis_point": [0, -0.2, 0], "axis": [0, 0, 1],
                     "radius": 0.45}],
     "controls": {"kind": "per_frame", "alpha": 1e-5},
-    "optimizer": {"max_evaluations": 45, "ftol_rel": 1e-10}})",
+    "optimizer": {"max_evaluations": 20, "ftol_rel": 1e-10}})",
                                   "arch-small.json");
   const Outcome o = optimise(scene);
   const json& m = o.measures.at(0);
@@ -63,9 +64,8 @@ TEST(ClothFigures, ArchReachesTheCylinderWithinOnePercentOfTheWidth) {
   std::printf("arch 10x10: %d evaluations, phi %.3g -> %.3g, %s\n", o.result.evaluations, o.phi0, o.result.phi,
               m.dump().c_str());
   EXPECT_GT(m.at("width").get<double>(), 0.99);
-  // The full scene (24x24, 150 evaluations) is held to 1 % of the width; this cut-down run to 3 %.
-  EXPECT_LE(m.at("rms_over_width").get<double>(), 0.03) << o.result.status << " after " << o.result.evaluations;
-  EXPECT_LT(o.result.phi, 0.05 * o.phi0);
+  EXPECT_LE(m.at("rms_over_width").get<double>(), 0.01) << o.result.status << " after " << o.result.evaluations;
+  EXPECT_LT(o.result.phi, 1e-3 * o.phi0);
 }
 
 TEST(ClothFigures, ShapesMatchBothPositionKeyframes) {
