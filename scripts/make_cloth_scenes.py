@@ -60,7 +60,7 @@ corners = [0, n - 1, (n - 1) * n, n * n - 1]
 flip = [r4([cx1 + (-h if c % n == 0 else h), cy1, (h if c // n == 0 else -h)]) for c in corners]
 dump("scenes/ring-toss.json", {
     "seed": 1,
-    "time": {"fps": 30, "substeps": 2, "frames": flip_frame},
+    "time": {"fps": 30, "substeps": 1, "frames": flip_frame},
     "cloth": {"nx": n, "ny": n, "width": size, "height": size, "origin": [cx0 - h, cy0, -h],
               "u_axis": [1, 0, 0], "v_axis": [0, 0, 1], "mass": 0.2, "velocity": [vx, vy, 0],
               "cg_tolerance": 1e-6,
@@ -70,7 +70,7 @@ dump("scenes/ring-toss.json", {
         {"type": "center_of_mass", "frame": com_frame, "weight": 100, "target": [0, 1.2, 0]},
         {"type": "position", "frame": flip_frame, "weight": 10, "particles": corners, "targets": flip},
     ],
-    "controls": {"kind": "initial_velocity", "alpha": 1e-6},
-    "optimizer": {"max_evaluations": 60, "ftol_rel": 1e-9},
+    "controls": {"kind": "initial_velocity", "alpha": 1e-3},
+    "optimizer": {"max_evaluations": 40, "ftol_rel": 1e-10},
     "render": {"camera": {"eye": [0.5, 2.2, 3.2], "target": [0, 1.0, 0]}},
 })
