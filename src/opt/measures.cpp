@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "opt/objective_terms.h"
+#include "sim/cloth/collider.h"
 
 namespace kf {
 
@@ -93,6 +94,10 @@ nlohmann::json figure_measures(const Scene& scene, const Trajectory& t) {
         sum += (seg(q, i) - o.targets[o.targets.size() == 1 ? 0 : k]).squaredNorm();
       }
       m["rms_error"] = std::sqrt(sum / n);
+      if (scene.cloth && o.type == "position") {
+        const double width = (seg(t.x[0], scene.cloth->nx - 1) - seg(t.x[0], 0)).norm();
+        m["rms_over_width"] = width > 0 ? std::sqrt(sum / n) / width : 0.0;
+      }
     } else if (o.type == "arch") {
       double sum = 0;
       const int p = int(x.size() / 3);
@@ -109,7 +114,54 @@ nlohmann::json figure_measures(const Scene& scene, const Trajectory& t) {
     }
     out.push_back(m);
   }
+  if (scene.cloth)
+    for (size_t k = 0; k < scene.cloth->colliders.size(); ++k)
+      if (scene.cloth->colliders[k].type == "torus") {
+        nlohmann::json m = ring_measures(scene.cloth->colliders[k], t);
+        m["collider"] = int(k);
+        out.push_back(m);
+      }
   return out;
+}
+
+nlohmann::json ring_measures(const ColliderSpec& torus, const Trajectory& t) {
+  const TorusCollider ring(torus);
+  const Vec3 axis = torus.axis.normalized();
+  const double inner = torus.radius - torus.tube_radius;
+  double min_phi = std::numeric_limits<double>::infinity();
+  double min_axis = std::numeric_limits<double>::infinity();
+  int crossings = 0;
+  Vec3 prev = Vec3::Zero();
+  for (int f = 0; f < t.frames(); ++f) {
+    const VecX& x = t.x[f];
+    for (int i = 0; i < x.size() / 3; ++i) {
+      double phi;
+      Vec3 n;
+      Mat3 dn;
+      ring.distance(seg(x, i), phi, n, dn);
+      min_phi = std::min(min_phi, phi);
+    }
+    const Vec3 com = mean_of(x, {});
+    if (f > 0) {
+      const double a0 = axis.dot(prev - torus.center), a1 = axis.dot(com - torus.center);
+      if ((a0 < 0) != (a1 < 0)) {
+        // Where the straight segment between the two frames' centres of mass meets the ring's plane.
+        const double s = a0 / (a0 - a1);
+        const Vec3 d = prev + s * (com - prev) - torus.center;
+        min_axis = std::min(min_axis, (d - axis.dot(d) * axis).norm());
+        ++crossings;
+      }
+    }
+    prev = com;
+  }
+  nlohmann::json m = {{"type", "ring"}};
+  m["crossings"] = crossings;
+  m["inner_radius"] = inner;
+  m["center_of_mass_through_ring"] = crossings > 0 && min_axis < inner;
+  m["min_distance_to_ring_axis_when_crossing"] = crossings > 0 ? nlohmann::json(min_axis) : nlohmann::json();
+  m["min_signed_distance"] = min_phi;
+  m["penetration_free"] = min_phi >= 0;
+  return m;
 }
 
 }  // namespace kf

@@ -12,8 +12,18 @@ namespace kf {
 //  center_of_mass: error, path_length, error_over_path;
 //  position on one agent of a flock (the race): rank_at_start, rank_at_end along the heading
 //    (0 = last, agents-1 = first), last_at_start, first_at_end;
-//  position/velocity otherwise: rms_error;  arch: rms_distance, width, rms_over_width.
+//  position/velocity otherwise: rms_error (metres, m/s; cloth also rms_over_width: over the sheet's width
+//    at frame 0);  arch: rms_distance, width, rms_over_width.
+// Then, for a cloth, one object per torus collider ("type": "ring", "collider": its index) over all frames:
+//  center_of_mass_through_ring (the centre of mass crosses the ring's plane inside the tube's inner circle),
+//  crossings (plane crossings of the centre of mass), min_distance_to_ring_axis_when_crossing (metres, null
+//  without a crossing), inner_radius (metres), min_signed_distance (to the torus surface over all particles
+//  and frames, metres; negative is penetration), penetration_free. Frames only: a contact between frames
+//  is not seen.
 nlohmann::json figure_measures(const Scene& scene, const Trajectory& frames);
+
+// Ring measures of one torus collider over the frames of a run (the "ring" object described above).
+nlohmann::json ring_measures(const ColliderSpec& torus, const Trajectory& frames);
 
 // Nearest-neighbour distance of each particle in the ground plane (x, z) at one state.
 std::vector<double> nearest_neighbour_spacing(const VecX& x);

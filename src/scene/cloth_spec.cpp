@@ -92,6 +92,7 @@ ClothSpec parse_cloth_spec(Block& b) {
   s.velocity = b.vec3("velocity", s.velocity, -1e4, 1e4);
   s.cg_tolerance = b.number("cg_tolerance", s.cg_tolerance, 1e-16, 1e-1);
   s.cg_max_iterations = b.integer("cg_max_iterations", s.cg_max_iterations, 1, 1'000'000);
+  s.cg_preconditioner = b.string("cg_preconditioner", s.cg_preconditioner, {"incomplete_cholesky", "block_jacobi"});
   for (Block& c : b.array("colliders")) s.colliders.push_back(parse_collider(std::move(c)));
   b.finish();
   return s;

@@ -41,6 +41,7 @@ struct ClothSpec {
   Vec3 velocity = Vec3::Zero();         // initial velocity of every free particle, m/s
   double cg_tolerance = 1e-8;           // PCG stops when |r| <= cg_tolerance * |b| (filtered)
   int cg_max_iterations = 1000;         // PCG failing to converge within this fails the step
+  std::string cg_preconditioner = "incomplete_cholesky";  // or "block_jacobi"
   std::vector<ColliderSpec> colliders;
 
   int particles() const { return nx * ny; }

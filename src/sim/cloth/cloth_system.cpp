@@ -98,7 +98,8 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   kv_.setZero(3 * p_);
   aw_.setZero(3 * p_);
   w_.setZero(3 * p_);
-  pcg_.resize(p_);
+  pcg_.resize(p_, spec.cg_preconditioner == "block_jacobi" ? Preconditioner::kBlockJacobi
+                                                           : Preconditioner::kIncompleteCholesky);
 }
 
 void ClothSystem::initial_state(VecX& x, VecX& v) const {
@@ -241,7 +242,8 @@ void ClothSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& 
 std::string ClothSystem::describe() const {
   std::ostringstream os;
   os << "cloth: " << spec_.nx << "x" << spec_.ny << " particles, " << springs_.size() << " springs, "
-     << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, block-Jacobi PCG";
+     << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, PCG ("
+     << spec_.cg_preconditioner << ")";
   return os.str();
 }
 

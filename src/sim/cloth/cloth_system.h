@@ -1,7 +1,7 @@
 #pragma once
 // Choi-Ko cloth stepped by linearised backward Euler (design §4), with its approximate adjoint.
 //
-// Forward:  A dv = b, A = M - h D - h^2 K, b = h (f + h K v + u), solved by block-Jacobi PCG with pinned
+// Forward:  A dv = b, A = M - h D - h^2 K, b = h (f + h K v + u), solved by PCG (IC(0)) with pinned
 //           particles filtered out (Baraff-Witkin); v1 = v + dv, x1 = x + h v1.
 // Backward: A^T w = vhat1 + h xhat1 on the free set, vhat = M w, xhat = xhat1 + h K^T w, uhat = h w.
 // In A (both passes) K is the springs' definite stiffness (compressive transverse part dropped) plus the

@@ -1,8 +1,11 @@
 #pragma once
 // Preconditioned conjugate gradients with the Baraff-Witkin filter: particles marked constrained keep the
 // value the caller put in x, and the solve runs on the free particles only (S A x = S b).
-// Preconditioner: the inverse of each free particle's 3x3 diagonal block (block Jacobi).
-// Reductions are serial over a fixed order, so results do not depend on the thread count.
+// Preconditioner: block incomplete Cholesky IC(0) on the free set (the factor keeps A's block pattern),
+// or the inverse of each free particle's 3x3 diagonal block (block Jacobi). IC(0) falls back to block
+// Jacobi for a step whose factorisation meets a pivot that is not positive definite.
+// Reductions and triangular solves are serial over a fixed order, so results do not depend on the thread
+// count.
 #include <vector>
 
 #include "core/types.h"
@@ -16,12 +19,17 @@ struct PcgResult {
   double relative_residual = 0;  // |S (b - A x)| / |S b|
 };
 
+enum class Preconditioner { kBlockJacobi, kIncompleteCholesky };
+
 class FilteredPcg {
  public:
   // Preallocates for p particles.
-  void resize(int p);
-  // Inverts the diagonal blocks of A on free particles. Call after A changes, before solve.
+  void resize(int p, Preconditioner kind = Preconditioner::kIncompleteCholesky);
+  // Builds the preconditioner from A (symmetric, blocks A_ji = A_ij^T) on free particles. Call after A
+  // changes, before solve.
   void prepare(const BlockSparse3& A, const std::vector<char>& free);
+  // True when the last prepare built an incomplete Cholesky factor (false: block Jacobi).
+  bool incomplete_cholesky() const { return ic_ok_; }
   // A: symmetric positive definite on the free set. b, x: 3p. On entry x holds the prescribed values on
   // constrained particles and, when `warm` is true, the initial guess on free ones (otherwise they start
   // at zero). Stops at |r| <= tol |S b|.
@@ -30,8 +38,12 @@ class FilteredPcg {
 
  private:
   void filter(const std::vector<char>& free, VecX& y) const;
-  void precondition(const std::vector<char>& free, const VecX& r, VecX& z) const;
-  std::vector<Mat3> inv_diag_;
+  void precondition(const BlockSparse3& A, const std::vector<char>& free, const VecX& r, VecX& z) const;
+  bool factor_ic(const BlockSparse3& A, const std::vector<char>& free);
+  Preconditioner kind_ = Preconditioner::kIncompleteCholesky;
+  bool ic_ok_ = false;
+  std::vector<Mat3> inv_diag_;  // block Jacobi: A_ii^-1; IC(0): L_ii^-1 (lower triangular)
+  std::vector<Mat3> lower_;     // IC(0): L_ij in A's slot (i, j), j < i
   VecX r_, z_, p_, q_;
 };
 

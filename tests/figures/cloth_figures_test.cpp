@@ -1,0 +1,163 @@
+// The cloth figures (arch, shapes, ring toss) on reduced versions of their scenes: each is optimised through
+// Problem + minimize and judged by figure_measures, as `keyframe optimize` does for the full scenes.
+// Also the approximate adjoint on scenes/cloth-gradcheck.json (6x6 cloth, 40 steps) at the scene's step.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "opt/gradcheck.h"
+#include "opt/measures.h"
+#include "opt/optimizer.h"
+#include "opt/problem.h"
+#include "scene/scene.h"
+#include "sim/make_system.h"
+
+namespace kf {
+namespace {
+
+using nlohmann::json;
+
+struct Outcome {
+  double phi0 = 0;
+  OptimizeResult result;
+  json measures;
+};
+
+// Optimises the scene and measures the best point's frames.
+Outcome optimise(const Scene& scene) {
+  auto sys = make_system(scene);
+  Problem problem(scene, scene.time, *sys);
+  Outcome out;
+  const VecX z0 = problem.initial_guess();
+  out.phi0 = problem.evaluate(z0, nullptr);
+  out.result = minimize(problem, scene.optimizer, z0);
+  problem.evaluate(out.result.z, nullptr);
+  EXPECT_FALSE(problem.last_diverged());
+  Trajectory t;
+  t.particles = sys->particles();
+  t.fps = scene.time.fps;
+  for (int f = 0; f <= scene.time.frames; ++f) {
+    t.x.push_back(problem.rollout().x[f * scene.time.substeps]);
+    t.v.push_back(problem.rollout().v[f * scene.time.substeps]);
+  }
+  out.measures = figure_measures(scene, t);
+  return out;
+}
+
+TEST(ClothFigures, ArchReachesTheCylinderWithinOnePercentOfTheWidth) {
+  // Weightless and in free space, as scenes/arch.json; h = 1/120 s, where the approximate adjoint is
+  // accurate enough for the line search to keep making progress (at 1/30 it stalls near 2 %).
+  const Scene scene = parse_scene(R"({
+    "time": {"fps": 30, "substeps": 4, "frames": 20},
+    "cloth": {"nx": 10, "ny": 10, "width": 1.0, "height": 1.0, "origin": [-0.5, 0, -0.5],
+              "u_axis": [1, 0, 0], "v_axis": [0, 0, 1], "mass": 0.5, "gravity": [0, 0, 0], "cg_tolerance": 1e-10},
+    "objectives": [{"type": "arch", "frame": 20, "weight": 100, "axis_point": [0, -0.2, 0], "axis": [0, 0, 1],
+                    "radius": 0.45}],
+    "controls": {"kind": "per_frame", "alpha": 1e-5},
+    "optimizer": {"max_evaluations": 20, "ftol_rel": 1e-10}})",
+                                  "arch-small.json");
+  const Outcome o = optimise(scene);
+  const json& m = o.measures.at(0);
+  ASSERT_EQ(m.at("type"), "arch");
+  std::printf("arch 10x10: %d evaluations, phi %.3g -> %.3g, %s\n", o.result.evaluations, o.phi0, o.result.phi,
+              m.dump().c_str());
+  EXPECT_GT(m.at("width").get<double>(), 0.99);
+  EXPECT_LE(m.at("rms_over_width").get<double>(), 0.01) << o.result.status << " after " << o.result.evaluations;
+  EXPECT_LT(o.result.phi, 1e-3 * o.phi0);
+}
+
+TEST(ClothFigures, ShapesMatchBothPositionKeyframes) {
+  // An 8x8 sheet hanging from its top edge: first swung out by 1 rad, then tilted back the other way.
+  const int n = 8;
+  const double d = 1.0 / (n - 1), top = 1.5;
+  json flat = json::array(), tilt = json::array();
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const double x = -0.5 + i * d, s = (n - 1 - j) * d;
+      flat.push_back({x, top - s * std::cos(1.0), s * std::sin(1.0)});
+      tilt.push_back({x, top - s * std::cos(0.5), -s * std::sin(0.5)});
+    }
+  json j = json::parse(R"({
+    "time": {"fps": 30, "substeps": 2, "frames": 30},
+    "cloth": {"nx": 8, "ny": 8, "width": 1.0, "height": 1.0, "origin": [-0.5, 0.5, 0], "mass": 0.3,
+              "pins": "top_edge", "cg_tolerance": 1e-6},
+    "controls": {"kind": "per_frame", "alpha": 1e-5},
+    "optimizer": {"max_evaluations": 40, "ftol_rel": 1e-10}})");
+  j["objectives"] = {{{"type", "position"}, {"frame", 15}, {"weight", 100}, {"targets", flat}},
+                     {{"type", "position"}, {"frame", 30}, {"weight", 100}, {"targets", tilt}}};
+  const Scene scene = parse_scene(j.dump(), "shapes-small.json");
+  const Outcome o = optimise(scene);
+  std::printf("shapes 8x8: %d evaluations, phi %.3g -> %.3g, %s\n", o.result.evaluations, o.phi0, o.result.phi,
+              o.measures.dump().c_str());
+  ASSERT_EQ(o.measures.size(), 2u);
+  for (const json& m : o.measures) {
+    ASSERT_EQ(m.at("type"), "position");
+    EXPECT_LT(m.at("rms_over_width").get<double>(), 0.03) << m.dump();
+  }
+  EXPECT_LT(o.result.phi, 1e-2 * o.phi0);
+}
+
+TEST(ClothFigures, RingTossPassesThroughTheRingWithoutPenetrating) {
+  // A 12x12 sheet thrown through a ring about the direction of the throw; only initial velocities change.
+  // The scene's initial velocity misses the ring (too low), so the optimiser has to find the throw.
+  const Scene scene = parse_scene(R"({
+    "time": {"fps": 30, "substeps": 1, "frames": 20},
+    "cloth": {"nx": 12, "ny": 12, "width": 0.4, "height": 0.4, "origin": [-1.4, 1.0, -0.2],
+              "u_axis": [1, 0, 0], "v_axis": [0, 0, 1], "mass": 0.2, "velocity": [2.4, 1.5, 0],
+              "cg_tolerance": 1e-6,
+              "colliders": [{"type": "torus", "center": [0, 1.2, 0], "axis": [1, 0, 0], "radius": 0.3,
+                             "tube_radius": 0.03, "thickness": 0.01, "stiffness": 1e3}]},
+    "objectives": [{"type": "center_of_mass", "frame": 15, "weight": 100, "target": [0, 1.2, 0]}],
+    "controls": {"kind": "initial_velocity", "alpha": 1e-6},
+    "optimizer": {"max_evaluations": 40, "ftol_rel": 1e-10}})",
+                                  "ring-toss-small.json");
+  const Outcome o = optimise(scene);
+  ASSERT_EQ(o.measures.size(), 2u);
+  const json& ring = o.measures.at(1);
+  ASSERT_EQ(ring.at("type"), "ring");
+  EXPECT_TRUE(ring.at("center_of_mass_through_ring").get<bool>()) << ring.dump();
+  EXPECT_LT(ring.at("min_distance_to_ring_axis_when_crossing").get<double>(), 0.05) << ring.dump();
+  EXPECT_GE(ring.at("min_signed_distance").get<double>(), 0.0) << ring.dump();
+  EXPECT_LT(o.measures.at(0).at("error").get<double>(), 0.01);
+}
+
+TEST(ClothFigures, RingMeasuresSeeAMissAndAPenetration) {
+  // Two hand-made frames: a single particle crosses the ring's plane inside the tube, then near the axis.
+  ColliderSpec torus;
+  torus.type = "torus";
+  torus.axis = Vec3::UnitX();
+  torus.radius = 0.3;
+  torus.tube_radius = 0.03;
+  Trajectory t;
+  t.particles = 1;
+  t.x = {Vec3(-0.01, 0.3, 0), Vec3(0.01, 0.3, 0)};
+  t.v = t.x;
+  json m = ring_measures(torus, t);
+  EXPECT_EQ(m.at("crossings"), 1);
+  EXPECT_FALSE(m.at("center_of_mass_through_ring").get<bool>());
+  EXPECT_NEAR(m.at("min_distance_to_ring_axis_when_crossing").get<double>(), 0.3, 1e-12);
+  EXPECT_LT(m.at("min_signed_distance").get<double>(), 0.0);
+  EXPECT_FALSE(m.at("penetration_free").get<bool>());
+  t.x = {Vec3(-0.01, 0.05, 0), Vec3(0.01, 0.05, 0)};
+  m = ring_measures(torus, t);
+  EXPECT_TRUE(m.at("center_of_mass_through_ring").get<bool>());
+  EXPECT_TRUE(m.at("penetration_free").get<bool>());
+}
+
+TEST(ClothFigures, GradcheckSceneAgreesWithFiniteDifferencesAtItsStep) {
+  const Scene scene = load_scene(std::string(KEYFRAME_SOURCE_DIR) + "/scenes/cloth-gradcheck.json");
+  ASSERT_EQ(scene.cloth->nx * scene.cloth->ny, 36);
+  ASSERT_EQ(scene.time.steps(), 40);
+  auto sys = make_system(scene);
+  Problem problem(scene, scene.time, *sys);
+  VecX z = problem.initial_guess() + 0.01 * VecX::Random(problem.size());
+  const GradcheckResult r = gradcheck(problem, z, 40, 1e-5, 3);
+  ASSERT_GT(r.grad_norm, 1e-6);
+  EXPECT_GE(r.checked, 30);
+  EXPECT_GE(r.cosine, 0.99) << "max_rel_error " << r.max_rel_error;
+}
+
+}  // namespace
+}  // namespace kf
