@@ -64,8 +64,9 @@ struct RtMesh {
       release(scene);
       if (m.triangles() == 0) return;
       geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-      // Cloth keeps its topology: refitting the BVH is far cheaper than rebuilding it.
-      rtcSetGeometryBuildQuality(geom, deforming ? RTC_BUILD_QUALITY_REFIT : RTC_BUILD_QUALITY_MEDIUM);
+      // Moving objects get a fresh LOW-quality build every frame (about a millisecond for 10k
+      // triangles): refitting the first frame's tree degrades badly once agents fly far apart.
+      rtcSetGeometryBuildQuality(geom, deforming ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM);
       vertices = m.vertices.size();
       triangles = size_t(m.triangles());
       rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertices);
