@@ -19,6 +19,12 @@ RunData load_run(const fs::path& run_dir) {
     throw InputError(d + ": trajectory.bin has " + std::to_string(run.trajectory.particles) +
                      " particles but scene.json describes " + std::to_string(run.scene.particles()));
   if (run.trajectory.frames() == 0) throw InputError(d + ": trajectory.bin holds no frames");
+  if (fs::exists(run_dir / "meshes.bin")) {
+    run.meshes = load_mesh_sequence(run_dir / "meshes.bin");
+    if (run.meshes->frames() != run.trajectory.frames())
+      throw InputError(d + ": meshes.bin has " + std::to_string(run.meshes->frames()) +
+                       " frames but trajectory.bin has " + std::to_string(run.trajectory.frames()));
+  }
   // The run keeps the original scene's name beside its copy; without it the directory names the run.
   std::ifstream names(run_dir / "scene_name.txt");
   std::string name;
@@ -35,12 +41,12 @@ FrameRenderer::FrameRenderer(const RunData& run, const std::string& backend, Ren
   if (settings_.width == 0) settings_.width = run.scene.render.width;
   if (settings_.height == 0) settings_.height = run.scene.render.height;
   if (settings_.spp == 0) settings_.spp = backend == "embree" ? run.scene.render.samples : 4;
-  bounds_ = scene_bounds(run.scene, run.trajectory);
+  bounds_ = scene_bounds(run.scene, run.trajectory, run.meshes ? &*run.meshes : nullptr);
   camera_ = make_camera(run.scene.render, bounds_, run.scene.flock.has_value(), settings_.width, settings_.height);
 }
 
 Image FrameRenderer::render(int frame, double orbit) {
-  build_frame_geometry(run_.scene, run_.trajectory, frame, bounds_, geometry_);
+  build_frame_geometry(run_.scene, run_.trajectory, frame, bounds_, geometry_, run_.meshes ? &*run_.meshes : nullptr);
   const Camera cam = orbit == 0.0 ? camera_ : camera_.orbited(orbit);
   return backend_->render(geometry_, cam, run_.scene.render, settings_);
 }

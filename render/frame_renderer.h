@@ -2,7 +2,10 @@
 // Loading a run directory and rendering its frames with one back end (shared by render_run and figures).
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
+
+#include "core/mesh_sequence.h"
 
 #include "core/trajectory.h"
 #include "render/backend.h"
@@ -13,9 +16,11 @@ namespace kf::render {
 struct RunData {
   Scene scene;
   Trajectory trajectory;
+  std::optional<MeshSequence> meshes;  // RUN_DIR/meshes.bin when the run has one (e.g. a character)
 };
 
-// Reads RUN_DIR/scene.json and RUN_DIR/trajectory.bin and checks they belong together.
+// Reads RUN_DIR/scene.json, RUN_DIR/trajectory.bin and, when present, RUN_DIR/meshes.bin (same frame
+// count as the trajectory) and checks they belong together.
 // Throws InputError with one line naming the directory or file.
 RunData load_run(const std::filesystem::path& run_dir);
 

@@ -31,6 +31,24 @@ bool is_keyframe(const RunData& run, int frame) {
                      [&](const auto& o) { return o.frame == frame; });
 }
 
+int last_keyframe(const RunData& run) {
+  int f = -1;
+  for (const auto& o : run.scene.objectives)
+    if (o.frame < run.trajectory.frames()) f = std::max(f, o.frame);
+  return f >= 0 ? f : run.trajectory.frames() - 1;
+}
+
+std::vector<int> resolve_frames(const RunData& run, const std::vector<int>& requested) {
+  if (requested.empty()) return default_frames(run);
+  std::vector<int> v;
+  for (int f : requested) v.push_back(f == kLastKeyframe ? last_keyframe(run) : f == kLastFrame ? run.trajectory.frames() - 1 : f);
+  return v;
+}
+
+std::string frame_caption(const RunData& run, int f) {
+  return "FRAME " + std::to_string(f) + (is_keyframe(run, f) ? " (KEY)" : "");
+}
+
 }  // namespace
 
 std::filesystem::path make_figure(const FigureRequest& r) {
@@ -46,25 +64,46 @@ std::filesystem::path make_figure(const FigureRequest& r) {
   for (const auto& d : r.run_dirs) runs.push_back(load_run(d));
   for (size_t k = 0; k < runs.size(); ++k)
     for (int f : r.frames)
-      if (f < 0 || f >= runs[k].trajectory.frames())
+      if ((f < 0 && f != kLastKeyframe && f != kLastFrame) || f >= runs[k].trajectory.frames())
         throw InputError("figure: frame " + std::to_string(f) + " out of range: " + r.run_dirs[k].string() +
                          " has frames 0.." + std::to_string(runs[k].trajectory.frames() - 1));
-  std::vector<FigureRow> rows;
-  for (const RunData& run : runs) {
+  // Each run's tiles and captions, in request order.
+  std::vector<std::vector<Image>> tiles(runs.size());
+  std::vector<std::vector<std::string>> captions(runs.size());
+  for (size_t k = 0; k < runs.size(); ++k) {
+    const RunData& run = runs[k];
     FrameRenderer renderer(run, r.backend, {r.width, r.height, r.spp});
-    const std::vector<int> frames = r.frames.empty() ? default_frames(run) : r.frames;
-    FigureRow row;
-    row.label = run.scene.name;
+    const std::vector<int> frames = resolve_frames(run, r.frames);
     std::vector<Image> images;
     for (int f : frames) images.push_back(renderer.render(f));
     if (r.overlay) {
-      row.tiles.push_back(overlay_frames(images));
-      row.captions.push_back("FRAMES " + std::to_string(frames.front()) + "-" + std::to_string(frames.back()));
+      tiles[k].push_back(overlay_frames(images));
+      captions[k].push_back("FRAMES " + std::to_string(frames.front()) + "-" + std::to_string(frames.back()));
     } else {
-      row.tiles = std::move(images);
-      for (int f : frames) row.captions.push_back("FRAME " + std::to_string(f) + (is_keyframe(run, f) ? " (KEY)" : ""));
+      tiles[k] = std::move(images);
+      for (int f : frames) captions[k].push_back(frame_caption(run, f));
     }
-    rows.push_back(std::move(row));
+  }
+  std::vector<FigureRow> rows;
+  if (!r.columns) {
+    for (size_t k = 0; k < runs.size(); ++k) rows.push_back({runs[k].scene.name, std::move(tiles[k]), captions[k]});
+  } else {
+    // Transposed: row i holds every run's i-th tile; each caption names its run (and frame).
+    size_t depth = 0;
+    for (const auto& t : tiles) depth = std::max(depth, t.size());
+    for (size_t i = 0; i < depth; ++i) {
+      FigureRow row;
+      bool same = true;
+      for (size_t k = 0; k < runs.size(); ++k)
+        same = same && i < captions[k].size() && captions[k][i] == captions[0][i];
+      row.label = same && i < captions[0].size() ? captions[0][i] : "";
+      for (size_t k = 0; k < runs.size(); ++k) {
+        if (i >= tiles[k].size()) continue;
+        row.tiles.push_back(std::move(tiles[k][i]));
+        row.captions.push_back(same ? runs[k].scene.name : runs[k].scene.name + " " + captions[k][i]);
+      }
+      rows.push_back(std::move(row));
+    }
   }
   const std::string name = r.name.empty() ? runs.front().scene.name : r.name;
   const Image sheet = compose_sheet(name, rows);

@@ -6,9 +6,18 @@
 
 namespace kf::render {
 
+// Frame numbers that stand for a frame of each run (runs may have different lengths and keyframes).
+constexpr int kLastKeyframe = -1;  // the run's last keyframe (its last frame if it has none)
+constexpr int kLastFrame = -2;     // the run's last frame
+
+// Paper-style sheets: fig. 1 = runs side by side at their last keyframe
+// (`--layout columns --frames key`), fig. 2/4/5 = strips over time (rows), fig. 3 = `--overlay`,
+// fig. 6 = three runs as columns, time going down (`--layout columns --frames 0,40,80,120`).
 struct FigureRequest {
-  std::vector<std::filesystem::path> run_dirs;  // one row each
-  std::vector<int> frames;                      // empty: frame 0, every keyframe, the last frame (at most 6)
+  std::vector<std::filesystem::path> run_dirs;  // one row each (one column each with `columns`)
+  std::vector<int> frames;                      // empty: frame 0, every keyframe, the last frame (at most 6);
+                                                // may hold kLastKeyframe / kLastFrame
+  bool columns = false;                         // runs side by side, frames going down
   std::string name;                             // output file name without .png; empty: first run's scene
   std::filesystem::path out_dir = "out/figures";
   std::string backend = "osmesa";

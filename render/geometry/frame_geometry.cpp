@@ -303,8 +303,31 @@ void build_cloth(const Scene& scene, const Trajectory& traj, int f, double scale
 
 }  // namespace
 
-Bounds scene_bounds(const Scene& scene, const Trajectory& traj) {
+void add_body_mesh(const MeshSequence& seq, int frame, int mesh, const Vec3& color, Mesh& out) {
+  const SequenceMesh& sm = seq.meshes[size_t(mesh)];
+  const float* p = seq.vertex_positions(frame, mesh);
+  auto P = [&](uint32_t i) { return Vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]); };
+  std::vector<Vec3> normal(size_t(sm.vertices), Vec3::Zero());
+  for (size_t t = 0; t + 2 < sm.triangles.size(); t += 3) {
+    const uint32_t a = sm.triangles[t], b = sm.triangles[t + 1], c = sm.triangles[t + 2];
+    const Vec3 n = (P(b) - P(a)).cross(P(c) - P(a));  // length = twice the area: the weight
+    normal[a] += n;
+    normal[b] += n;
+    normal[c] += n;
+  }
+  const uint32_t base = uint32_t(out.vertices.size());
+  for (int i = 0; i < sm.vertices; ++i) {
+    const Vec3& n = normal[size_t(i)];
+    add_vertex(out, P(uint32_t(i)), n.norm() > 1e-30 ? n.normalized() : Vec3::UnitY(), color, color);
+  }
+  for (uint32_t i : sm.triangles) out.indices.push_back(base + i);
+}
+
+Bounds scene_bounds(const Scene& scene, const Trajectory& traj, const MeshSequence* meshes) {
   Bounds b;
+  if (meshes)
+    for (const auto& f : meshes->positions)
+      for (size_t i = 0; i + 2 < f.size(); i += 3) b.add(Vec3(f[i], f[i + 1], f[i + 2]));
   for (const VecX& x : traj.x)
     for (int i = 0; i < traj.particles; ++i) b.add(seg(x, i));
   for (const auto& o : scene.objectives) {
@@ -325,7 +348,7 @@ Bounds scene_bounds(const Scene& scene, const Trajectory& traj) {
 }
 
 void build_frame_geometry(const Scene& scene, const Trajectory& traj, int frame, const Bounds& bounds,
-                          FrameGeometry& out) {
+                          FrameGeometry& out, const MeshSequence* meshes) {
   out.scale = scene_scale(bounds);
   const GroundPlane plane = ground_plane(scene, bounds);
   if (out.ground.vertices.empty() || plane.normal != out.plane.normal || plane.offset != out.plane.offset) {
@@ -337,6 +360,8 @@ void build_frame_geometry(const Scene& scene, const Trajectory& traj, int frame,
   out.objects.clear();
   if (scene.flock) build_flock(scene, traj, frame, out.scale, out.plane, out);
   if (scene.cloth) build_cloth(scene, traj, frame, out.scale, out);
+  if (meshes)
+    for (int k = 0; k < int(meshes->meshes.size()); ++k) add_body_mesh(*meshes, frame, k, scene.render.body_color, out.objects);
 }
 
 }  // namespace kf::render

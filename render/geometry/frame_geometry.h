@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/mesh_sequence.h"
 #include "core/trajectory.h"
 #include "render/camera.h"
 #include "scene/scene.h"
@@ -40,11 +41,16 @@ struct FrameGeometry {
   long ground_id = 0;  // changes whenever `ground` was rebuilt (back ends keep it otherwise)
 };
 
-// Bounding box of the trajectory over all frames plus the keyframe targets it should show.
-Bounds scene_bounds(const Scene& scene, const Trajectory& traj);
+// Bounding box of the trajectory (and `meshes`, if any) over all frames plus the keyframe targets it
+// should show.
+Bounds scene_bounds(const Scene& scene, const Trajectory& traj, const MeshSequence* meshes = nullptr);
+
+// Appends mesh `mesh` of `seq` at `frame` to `out`: one colour both sides, area-weighted vertex normals.
+void add_body_mesh(const MeshSequence& seq, int frame, int mesh, const Vec3& color, Mesh& out);
 
 // Builds frame `frame` (0 <= frame < traj.frames()) of `scene` into `out`, reusing its storage.
+// `meshes` (frame count as traj, may be null): drawn among the objects in the body colour, smooth shaded.
 void build_frame_geometry(const Scene& scene, const Trajectory& traj, int frame, const Bounds& bounds,
-                          FrameGeometry& out);
+                          FrameGeometry& out, const MeshSequence* meshes = nullptr);
 
 }  // namespace kf::render

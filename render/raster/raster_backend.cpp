@@ -3,6 +3,7 @@
 #include <GL/glext.h>
 
 #include <array>
+#include <cstring>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -173,13 +174,20 @@ class RasterBackend final : public Backend {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo_);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     Image img(width_, height_, 3);
-    rgba_.resize(size_t(width_) * height_ * 4);
-    glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, rgba_.data());
+    // Read RGB straight into the image, then flip it row by row (OpenGL's rows start at the bottom):
+    // a per-channel copy loop cost as much as drawing the frame.
+    glReadPixels(0, 0, width_, height_, GL_RGB, GL_UNSIGNED_BYTE, img.pixels.data());
     if (GLenum e = glGetError(); e != GL_NO_ERROR)
       throw std::runtime_error("OpenGL error " + std::to_string(e) + " while rendering");
-    for (int y = 0; y < height_; ++y)  // OpenGL's rows start at the bottom
-      for (int x = 0; x < width_; ++x)
-        for (int c = 0; c < 3; ++c) img.at(x, height_ - 1 - y)[c] = rgba_[(size_t(y) * width_ + x) * 4 + c];
+    const size_t row = size_t(width_) * 3;
+    row_.resize(row);
+    for (int y = 0; y < height_ / 2; ++y) {
+      uint8_t* a = img.at(0, y);
+      uint8_t* b = img.at(0, height_ - 1 - y);
+      std::memcpy(row_.data(), a, row);
+      std::memcpy(a, b, row);
+      std::memcpy(b, row_.data(), row);
+    }
     return img;
   }
 
@@ -259,7 +267,7 @@ class RasterBackend final : public Backend {
   int width_ = 0, height_ = 0, samples_ = 0;
   long ground_id_ = -1;
   std::array<GpuMesh, 3> meshes_;  // ground, marks, objects
-  std::vector<unsigned char> rgba_;
+  std::vector<unsigned char> row_;  // one image row, for the vertical flip
 };
 
 }  // namespace

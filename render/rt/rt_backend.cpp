@@ -64,8 +64,9 @@ struct RtMesh {
       release(scene);
       if (m.triangles() == 0) return;
       geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-      // Cloth keeps its topology: refitting the BVH is far cheaper than rebuilding it.
-      rtcSetGeometryBuildQuality(geom, deforming ? RTC_BUILD_QUALITY_REFIT : RTC_BUILD_QUALITY_MEDIUM);
+      // Moving objects get a fresh LOW-quality build every frame (about a millisecond for 10k
+      // triangles): refitting the first frame's tree degrades badly once agents fly far apart.
+      rtcSetGeometryBuildQuality(geom, deforming ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM);
       vertices = m.vertices.size();
       triangles = size_t(m.triangles());
       rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertices);
@@ -133,102 +134,132 @@ class RtBackend final : public Backend {
     sh.background = from(look.background);
 
     constexpr int kTile = 16;
+    static_assert(kTile % kLanes == 0, "tiles hold whole packets");
     tbb::parallel_for(tbb::blocked_range2d<int>(0, (H + kTile - 1) / kTile, 1, 0, (W + kTile - 1) / kTile, 1),
                       [&](const tbb::blocked_range2d<int>& r) {
-                        RTCIntersectContext ctx;
-                        rtcInitIntersectContext(&ctx);
                         for (int ty = r.rows().begin(); ty < r.rows().end(); ++ty)
                           for (int tx = r.cols().begin(); tx < r.cols().end(); ++tx)
                             for (int y = ty * kTile; y < std::min(H, (ty + 1) * kTile); ++y)
-                              for (int x = tx * kTile; x < std::min(W, (tx + 1) * kTile); ++x)
-                                shade_pixel(ctx, sh, x, y, W, H, spp, img.at(x, y));
+                              for (int x = tx * kTile; x < std::min(W, (tx + 1) * kTile); x += kLanes)
+                                shade_packet(sh, x, y, W, H, spp, img);
                       });
     return img;
   }
 
  private:
+  // Rays travel in packets of 8 (one per pixel of a row run): Embree traces them about twice as fast
+  // as single rays, and each pixel still draws its own random numbers in the same order.
+  static constexpr int kLanes = 8;
+
   struct Shading {
     V3 eye, forward, right, up, sun, sun_t, sun_b, background;
     float sun_radius, ambient, norm_k, eps, ao_distance;
   };
 
-  bool occluded(RTCIntersectContext& ctx, V3 o, V3 d, float tfar) const {
-    RTCRay ray;
-    ray.org_x = o.x, ray.org_y = o.y, ray.org_z = o.z;
-    ray.dir_x = d.x, ray.dir_y = d.y, ray.dir_z = d.z;
-    ray.tnear = 0.0f;
-    ray.tfar = tfar;
-    ray.time = 0.0f;
-    ray.mask = ~0u;
-    ray.id = 0;
-    ray.flags = 0;
-    rtcOccluded1(scene_.get(), &ctx, &ray);
-    return ray.tfar < 0.0f;
+  static void set_ray(RTCRay8& r, int l, V3 o, V3 d, float tfar) {
+    r.org_x[l] = o.x, r.org_y[l] = o.y, r.org_z[l] = o.z;
+    r.dir_x[l] = d.x, r.dir_y[l] = d.y, r.dir_z[l] = d.z;
+    r.tnear[l] = 0.0f;
+    r.tfar[l] = tfar;
+    r.time[l] = 0.0f;
+    r.mask[l] = ~0u;
+    r.id[l] = unsigned(l);
+    r.flags[l] = 0;
   }
 
-  void shade_pixel(RTCIntersectContext& ctx, const Shading& sh, int x, int y, int W, int H, int spp,
-                   uint8_t* out) const {
-    Rng rng{pcg_hash(uint32_t(y) * 0x9E3779B9u ^ pcg_hash(uint32_t(x)))};
-    V3 sum{0, 0, 0};
-    for (int s = 0; s < spp; ++s) {
-      const float px = (float(x) + rng.next()) / float(W) * 2.0f - 1.0f;
-      const float py = 1.0f - (float(y) + rng.next()) / float(H) * 2.0f;
-      const V3 dir = normalize(sh.forward + sh.right * px + sh.up * py);
-      RTCRayHit rh;
-      rh.ray.org_x = sh.eye.x, rh.ray.org_y = sh.eye.y, rh.ray.org_z = sh.eye.z;
-      rh.ray.dir_x = dir.x, rh.ray.dir_y = dir.y, rh.ray.dir_z = dir.z;
-      rh.ray.tnear = 0.0f;
-      rh.ray.tfar = INFINITY;
-      rh.ray.time = 0.0f;
-      rh.ray.mask = ~0u;
-      rh.ray.id = 0;
-      rh.ray.flags = 0;
-      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-      rtcIntersect1(scene_.get(), &ctx, &rh);
-      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-        sum = sum + sh.background;
-        continue;
-      }
-      const Mesh* m = nullptr;
-      for (const auto& rm : meshes_)
-        if (rm.id == rh.hit.geomID) m = rm.source;
-      const uint32_t* tri = &m->indices[size_t(rh.hit.primID) * 3];
-      const Vertex &a = m->vertices[tri[0]], &b = m->vertices[tri[1]], &c = m->vertices[tri[2]];
-      const float u = rh.hit.u, v = rh.hit.v, w = 1.0f - u - v;
-      V3 n = normalize(from(a.n) * w + from(b.n) * u + from(c.n) * v);
-      V3 albedo = from(a.front) * w + from(b.front) * u + from(c.front) * v;
-      if (dot(n, dir) > 0.0f) {  // seen from behind: the other side's colour
-        n = n * -1.0f;
-        albedo = from(a.back) * w + from(b.back) * u + from(c.back) * v;
-      }
-      V3 ng = normalize(V3{rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z});
-      if (dot(ng, dir) > 0.0f) ng = ng * -1.0f;
-      const V3 p = sh.eye + dir * rh.ray.tfar + ng * sh.eps;
-      // Sun: a point on a disc of directions around the light direction.
-      float sun = 0.0f;
-      {
-        const float r = sh.sun_radius * std::sqrt(rng.next()), phi = 6.2831853f * rng.next();
-        const V3 l = normalize(sh.sun + sh.sun_t * (r * std::cos(phi)) + sh.sun_b * (r * std::sin(phi)));
-        const float ndl = dot(n, l);
-        if (ndl > 0.0f && !occluded(ctx, p, l, INFINITY)) sun = ndl;
-      }
-      // Sky: cosine-weighted direction, occluded within a short distance.
-      float sky = 0.0f;
-      {
-        V3 t, bt;
-        orthonormal(n, t, bt);
-        const float r1 = rng.next(), r2 = rng.next();
-        const float rr = std::sqrt(r1), phi = 6.2831853f * r2;
-        const V3 d = normalize(t * (rr * std::cos(phi)) + bt * (rr * std::sin(phi)) + n * std::sqrt(1.0f - r1));
-        if (dot(d, ng) > 0.0f && !occluded(ctx, p, d, sh.ao_distance)) sky = 0.75f + 0.25f * n.y;
-      }
-      sum = sum + albedo * ((sh.ambient * sky + sun) * sh.norm_k);
+  // Pixels x..x+7 of row y (those inside the image), spp samples each, written into `img`.
+  void shade_packet(const Shading& sh, int x0, int y, int W, int H, int spp, Image& img) const {
+    alignas(32) int valid[kLanes], sun_valid[kLanes], sky_valid[kLanes];
+    Rng rng[kLanes];
+    V3 sum[kLanes], albedo[kLanes];
+    float ndl[kLanes], sky_weight[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+      const int x = x0 + l;
+      valid[l] = x < W ? -1 : 0;
+      rng[l] = Rng{pcg_hash(uint32_t(y) * 0x9E3779B9u ^ pcg_hash(uint32_t(x)))};
+      sum[l] = V3{0, 0, 0};
     }
-    const V3 c = sum * (1.0f / float(spp));
-    out[0] = uint8_t(std::lround(std::clamp(c.x, 0.0f, 1.0f) * 255.0f));
-    out[1] = uint8_t(std::lround(std::clamp(c.y, 0.0f, 1.0f) * 255.0f));
-    out[2] = uint8_t(std::lround(std::clamp(c.z, 0.0f, 1.0f) * 255.0f));
+    RTCIntersectContext primary_ctx, shadow_ctx;
+    rtcInitIntersectContext(&primary_ctx);
+    primary_ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcInitIntersectContext(&shadow_ctx);
+    alignas(32) RTCRayHit8 rh;
+    alignas(32) RTCRay8 sun_rays, sky_rays;
+    for (int s = 0; s < spp; ++s) {
+      for (int l = 0; l < kLanes; ++l) {
+        if (!valid[l]) continue;
+        const float px = (float(x0 + l) + rng[l].next()) / float(W) * 2.0f - 1.0f;
+        const float py = 1.0f - (float(y) + rng[l].next()) / float(H) * 2.0f;
+        set_ray(rh.ray, l, sh.eye, normalize(sh.forward + sh.right * px + sh.up * py), INFINITY);
+        rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+      }
+      rtcIntersect8(valid, scene_.get(), &primary_ctx, &rh);
+      for (int l = 0; l < kLanes; ++l) {
+        sun_valid[l] = sky_valid[l] = 0;
+        if (!valid[l]) continue;
+        if (rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) {
+          sum[l] = sum[l] + sh.background;
+          continue;
+        }
+        const V3 dir{rh.ray.dir_x[l], rh.ray.dir_y[l], rh.ray.dir_z[l]};
+        const Mesh* m = nullptr;
+        for (const auto& rm : meshes_)
+          if (rm.id == rh.hit.geomID[l]) m = rm.source;
+        const uint32_t* tri = &m->indices[size_t(rh.hit.primID[l]) * 3];
+        const Vertex &a = m->vertices[tri[0]], &b = m->vertices[tri[1]], &c = m->vertices[tri[2]];
+        const float u = rh.hit.u[l], v = rh.hit.v[l], w = 1.0f - u - v;
+        V3 n = normalize(from(a.n) * w + from(b.n) * u + from(c.n) * v);
+        albedo[l] = from(a.front) * w + from(b.front) * u + from(c.front) * v;
+        if (dot(n, dir) > 0.0f) {  // seen from behind: the other side's colour
+          n = n * -1.0f;
+          albedo[l] = from(a.back) * w + from(b.back) * u + from(c.back) * v;
+        }
+        V3 ng = normalize(V3{rh.hit.Ng_x[l], rh.hit.Ng_y[l], rh.hit.Ng_z[l]});
+        if (dot(ng, dir) > 0.0f) ng = ng * -1.0f;
+        const V3 p = sh.eye + dir * rh.ray.tfar[l] + ng * sh.eps;
+        // Sun: a point on a disc of directions around the light direction.
+        {
+          const float r = sh.sun_radius * std::sqrt(rng[l].next()), phi = 6.2831853f * rng[l].next();
+          const V3 d = normalize(sh.sun + sh.sun_t * (r * std::cos(phi)) + sh.sun_b * (r * std::sin(phi)));
+          ndl[l] = dot(n, d);
+          if (ndl[l] > 0.0f) {
+            sun_valid[l] = -1;
+            set_ray(sun_rays, l, p, d, INFINITY);
+          }
+        }
+        // Sky: cosine-weighted direction, occluded within a short distance.
+        {
+          V3 t, bt;
+          orthonormal(n, t, bt);
+          const float r1 = rng[l].next(), r2 = rng[l].next();
+          const float rr = std::sqrt(r1), phi = 6.2831853f * r2;
+          const V3 d = normalize(t * (rr * std::cos(phi)) + bt * (rr * std::sin(phi)) + n * std::sqrt(1.0f - r1));
+          sky_weight[l] = 0.75f + 0.25f * n.y;
+          if (dot(d, ng) > 0.0f) {
+            sky_valid[l] = -1;
+            set_ray(sky_rays, l, p, d, sh.ao_distance);
+          }
+        }
+      }
+      rtcOccluded8(sun_valid, scene_.get(), &shadow_ctx, &sun_rays);
+      rtcOccluded8(sky_valid, scene_.get(), &shadow_ctx, &sky_rays);
+      for (int l = 0; l < kLanes; ++l) {
+        if (!valid[l] || rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) continue;
+        // Embree marks an occluded ray with tfar = -inf.
+        const float sun = sun_valid[l] && sun_rays.tfar[l] >= 0.0f ? ndl[l] : 0.0f;
+        const float sky = sky_valid[l] && sky_rays.tfar[l] >= 0.0f ? sky_weight[l] : 0.0f;
+        sum[l] = sum[l] + albedo[l] * ((sh.ambient * sky + sun) * sh.norm_k);
+      }
+    }
+    for (int l = 0; l < kLanes; ++l) {
+      if (!valid[l]) continue;
+      const V3 c = sum[l] * (1.0f / float(spp));
+      uint8_t* out = img.at(x0 + l, y);
+      out[0] = uint8_t(std::lround(std::clamp(c.x, 0.0f, 1.0f) * 255.0f));
+      out[1] = uint8_t(std::lround(std::clamp(c.y, 0.0f, 1.0f) * 255.0f));
+      out[2] = uint8_t(std::lround(std::clamp(c.z, 0.0f, 1.0f) * 255.0f));
+    }
   }
 
   EmbreeDevice device_;

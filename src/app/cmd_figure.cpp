@@ -14,23 +14,35 @@ void add_figure_command(CLI::App& app) {
   auto frames = std::make_shared<std::string>();
   auto size = std::make_shared<std::string>();
   sub->add_option("RUN_DIR", req->run_dirs, "run directories, one row each")->required();
-  sub->add_option("--frames", *frames, "comma-separated frames, e.g. 0,30,60 (default: 0, keyframes, last)");
+  sub->add_option("--frames", *frames,
+                  "comma-separated frames, e.g. 0,30,60; 'key' = each run's last keyframe, 'last' = its last "
+                  "frame (default: 0, keyframes, last)");
+  sub->add_flag("--columns", req->columns, "runs side by side, frames going down (paper figures 1 and 6)");
   sub->add_option("--name", req->name, "figure name (default: the first run's scene name)");
   sub->add_option("--out-dir", req->out_dir, "where the sheet goes")->capture_default_str();
   sub->add_option("--backend", req->backend, "osmesa | embree")->capture_default_str();
   sub->add_option("--size", *size, "tile size WxH in pixels (default 400x300)");
   sub->add_option("--spp", req->spp, "samples per pixel (default: back end default)");
   sub->add_flag("--overlay", req->overlay, "superimpose the frames into one tile per run (trails)");
+  sub->footer("Paper layouts: fig. 1  keyframe figure out/square out/cross out/arch --columns --frames key\n"
+              "               fig. 2  keyframe figure out/race   (a strip over time)\n"
+              "               fig. 3  keyframe figure out/path --overlay --frames 0,30,60,90,120\n"
+              "               fig. 6  keyframe figure out/capeA out/blend out/capeB --columns --frames 0,40,80");
   sub->callback([=] {
     render::FigureRequest r = *req;
     if (!frames->empty()) {
       std::stringstream ss(*frames);
       std::string item;
       while (std::getline(ss, item, ',')) {
+        if (item == "key" || item == "last") {
+          r.frames.push_back(item == "key" ? render::kLastKeyframe : render::kLastFrame);
+          continue;
+        }
         try {
           size_t used = 0;
-          r.frames.push_back(std::stoi(item, &used));
-          if (used != item.size()) throw std::invalid_argument(item);
+          const int f = std::stoi(item, &used);
+          if (used != item.size() || f < 0) throw std::invalid_argument(item);
+          r.frames.push_back(f);
         } catch (const std::exception&) {
           throw InputError("--frames: expected comma-separated frame numbers, got \"" + *frames + "\"");
         }

@@ -17,5 +17,7 @@ void add_render_command(CLI::App& app);
 void add_gradcheck_command(CLI::App& app);
 void add_figure_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_clip_command(CLI::App& app);
+void add_export_command(CLI::App& app);
 
 }  // namespace kf

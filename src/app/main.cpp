@@ -27,6 +27,8 @@ int main(int argc, char** argv) {
   add_gradcheck_command(app);
   add_figure_command(app);
   add_bench_command(app);
+  add_clip_command(app);
+  add_export_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

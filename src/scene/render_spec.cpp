@@ -41,6 +41,7 @@ RenderSpec parse_render_spec(Block& b) {
   s.cloth_front = b.vec3("cloth_front", s.cloth_front, 0.0, 1.0);
   s.cloth_back = b.vec3("cloth_back", s.cloth_back, 0.0, 1.0);
   s.collider_color = b.vec3("collider_color", s.collider_color, 0.0, 1.0);
+  s.body_color = b.vec3("body_color", s.body_color, 0.0, 1.0);
   b.finish();
   return s;
 }

@@ -34,6 +34,7 @@ struct RenderSpec {
   Vec3 cloth_front = Vec3(0.82, 0.24, 0.20);
   Vec3 cloth_back = Vec3(0.95, 0.82, 0.45);
   Vec3 collider_color = Vec3(0.62, 0.64, 0.70);
+  Vec3 body_color = Vec3(0.87, 0.67, 0.54);       // meshes of RUN_DIR/meshes.bin (skin)
 };
 
 // Reads the "render" block; unknown keys are errors. Throws InputError.

@@ -50,4 +50,25 @@ TEST(Figure, StripOfTwoRunsAndOverlay) {
   EXPECT_FALSE(std::filesystem::exists(tmp.path() / "figures/bad.png"));
 }
 
+TEST(Figure, ColumnsPutRunsSideBySideAtTheirLastKeyframe) {
+  testing::TempDir tmp;
+  FigureRequest r;
+  r.run_dirs = {testing::make_flock_run(tmp.path() / "flock"), testing::make_cloth_run(tmp.path() / "cloth", 8),
+                testing::make_flock_run(tmp.path() / "flock2")};
+  r.frames = {kLastKeyframe};
+  r.columns = true;
+  r.width = 80;
+  r.height = 60;
+  r.out_dir = tmp.path() / "figures";
+  r.name = "fig1";
+  const Image one_row = read_png(make_figure(r));
+  EXPECT_GT(one_row.width, 3 * 80);  // three runs across
+  EXPECT_LT(one_row.height, 2 * 60 + 100);
+  r.frames = {0, kLastFrame};
+  r.name = "fig6";
+  const Image two_rows = read_png(make_figure(r));
+  EXPECT_EQ(two_rows.width, one_row.width);
+  EXPECT_GT(two_rows.height, one_row.height + 60);
+}
+
 }  // namespace kf::render

@@ -1,0 +1,225 @@
+#include "render/export/export_run.h"
+
+#include <Eigen/Geometry>
+#include <assimp/Exporter.hpp>
+#include <assimp/material.h>
+#include <assimp/scene.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "render/frame_renderer.h"
+
+namespace kf::render {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Format {
+  const char* name;       // --format
+  const char* assimp_id;  // assimp's exporter id
+  const char* extension;
+  bool one_file;          // all frames in one file
+};
+constexpr Format kFormats[] = {
+    {"obj", "obj", ".obj", false},
+    {"ply", "plyb", ".ply", false},
+    {"gltf2", "gltf2", ".gltf", true},
+};
+
+// A named triangle mesh with per-vertex normals, single precision like the file formats.
+struct ExportMesh {
+  std::string name;
+  std::vector<float> p, n;       // 3V each, metres / unit
+  std::vector<uint32_t> indices;  // 3T
+  Vec3 color;
+};
+
+aiMesh* to_ai_mesh(const ExportMesh& m, unsigned material) {
+  auto* out = new aiMesh;
+  out->mName = m.name;
+  out->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+  out->mMaterialIndex = material;
+  out->mNumVertices = unsigned(m.p.size() / 3);
+  out->mVertices = new aiVector3D[out->mNumVertices];
+  out->mNormals = new aiVector3D[out->mNumVertices];
+  for (unsigned i = 0; i < out->mNumVertices; ++i) {
+    out->mVertices[i] = aiVector3D(m.p[3 * i], m.p[3 * i + 1], m.p[3 * i + 2]);
+    out->mNormals[i] = aiVector3D(m.n[3 * i], m.n[3 * i + 1], m.n[3 * i + 2]);
+  }
+  out->mNumFaces = unsigned(m.indices.size() / 3);
+  out->mFaces = new aiFace[out->mNumFaces];
+  for (unsigned f = 0; f < out->mNumFaces; ++f) {
+    out->mFaces[f].mNumIndices = 3;
+    out->mFaces[f].mIndices = new unsigned[3]{m.indices[3 * f], m.indices[3 * f + 1], m.indices[3 * f + 2]};
+  }
+  return out;
+}
+
+aiMaterial* to_ai_material(const std::string& name, const Vec3& c) {
+  auto* mat = new aiMaterial;
+  const aiString n(name);
+  mat->AddProperty(&n, AI_MATKEY_NAME);
+  const aiColor3D diffuse(float(c.x()), float(c.y()), float(c.z()));
+  mat->AddProperty(&diffuse, 1, AI_MATKEY_COLOR_DIFFUSE);
+  const aiColor4D base(float(c.x()), float(c.y()), float(c.z()), 1.0f);
+  mat->AddProperty(&base, 1, AI_MATKEY_BASE_COLOR);
+  return mat;
+}
+
+// One scene: a root with one child node per group (a frame), each holding its meshes.
+std::unique_ptr<aiScene> make_scene(const std::vector<std::pair<std::string, std::vector<ExportMesh>>>& groups) {
+  auto scene = std::make_unique<aiScene>();
+  scene->mRootNode = new aiNode("keyframe");
+  unsigned meshes = 0;
+  for (const auto& g : groups) meshes += unsigned(g.second.size());
+  scene->mNumMeshes = meshes;
+  scene->mMeshes = new aiMesh*[meshes];
+  scene->mNumMaterials = meshes;
+  scene->mMaterials = new aiMaterial*[meshes];
+  scene->mRootNode->mNumChildren = unsigned(groups.size());
+  scene->mRootNode->mChildren = new aiNode*[groups.size()];
+  unsigned k = 0;
+  for (size_t gi = 0; gi < groups.size(); ++gi) {
+    auto* node = new aiNode(groups[gi].first);
+    node->mParent = scene->mRootNode;
+    scene->mRootNode->mChildren[gi] = node;
+    node->mNumMeshes = unsigned(groups[gi].second.size());
+    node->mMeshes = new unsigned[node->mNumMeshes];
+    for (size_t j = 0; j < groups[gi].second.size(); ++j, ++k) {
+      const ExportMesh& m = groups[gi].second[j];
+      scene->mMaterials[k] = to_ai_material(m.name, m.color);
+      scene->mMeshes[k] = to_ai_mesh(m, k);
+      node->mMeshes[j] = k;
+    }
+  }
+  return scene;
+}
+
+ExportMesh from_render_mesh(const std::string& name, const Mesh& m, const Vec3& color) {
+  ExportMesh e{name, {}, {}, m.indices, color};
+  for (const Vertex& v : m.vertices) {
+    e.p.insert(e.p.end(), v.p, v.p + 3);
+    e.n.insert(e.n.end(), v.n, v.n + 3);
+  }
+  return e;
+}
+
+// The frame's meshes: the particles as a surface (cloth grid or agent arrowheads) and the bodies.
+std::vector<ExportMesh> frame_meshes(const RunData& run, int frame, const Bounds& bounds, FrameGeometry& g) {
+  std::vector<ExportMesh> out;
+  const RenderSpec& rs = run.scene.render;
+  if (run.scene.cloth) {
+    const int nx = run.scene.cloth->nx, ny = run.scene.cloth->ny;
+    const VecX& x = run.trajectory.x[size_t(frame)];
+    ExportMesh e{"cloth", {}, {}, {}, rs.cloth_front};
+    std::vector<Vec3> normal(size_t(nx) * ny, Vec3::Zero());
+    for (int j = 0; j + 1 < ny; ++j)
+      for (int i = 0; i + 1 < nx; ++i) {
+        const uint32_t a = uint32_t(j * nx + i), b = a + 1, c = a + uint32_t(nx) + 1, d = a + uint32_t(nx);
+        e.indices.insert(e.indices.end(), {a, b, c, a, c, d});
+        const Vec3 n1 = (seg(x, int(b)) - seg(x, int(a))).cross(seg(x, int(c)) - seg(x, int(a)));
+        const Vec3 n2 = (seg(x, int(c)) - seg(x, int(a))).cross(seg(x, int(d)) - seg(x, int(a)));
+        for (uint32_t v : {a, b, c}) normal[v] += n1;
+        for (uint32_t v : {a, c, d}) normal[v] += n2;
+      }
+    for (int i = 0; i < nx * ny; ++i) {
+      const Vec3 p = seg(x, i), n = normal[size_t(i)].norm() > 1e-30 ? normal[size_t(i)].normalized() : Vec3::UnitY();
+      e.p.insert(e.p.end(), {float(p.x()), float(p.y()), float(p.z())});
+      e.n.insert(e.n.end(), {float(n.x()), float(n.y()), float(n.z())});
+    }
+    out.push_back(std::move(e));
+  } else if (run.scene.flock) {
+    build_frame_geometry(run.scene, run.trajectory, frame, bounds, g);
+    out.push_back(from_render_mesh("agents", g.objects, rs.agent_color));
+  }
+  if (run.meshes) {
+    for (int k = 0; k < int(run.meshes->meshes.size()); ++k) {
+      Mesh body;
+      add_body_mesh(*run.meshes, frame, k, rs.body_color, body);
+      out.push_back(from_render_mesh(run.meshes->meshes[size_t(k)].name, body, rs.body_color));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> export_format_names() {
+  std::vector<std::string> names;
+  for (const auto& f : kFormats) names.push_back(f.name);
+  return names;
+}
+
+std::vector<fs::path> export_run(const ExportRequest& r) {
+  const Format* format = nullptr;
+  for (const auto& f : kFormats)
+    if (r.format == f.name) format = &f;
+  if (!format) {
+    std::string names;
+    for (const auto& n : export_format_names()) names += (names.empty() ? "" : ", ") + n;
+    throw InputError("unknown export format \"" + r.format + "\" (expected one of: " + names + ")");
+  }
+  const RunData run = load_run(r.run_dir);
+  const int F = run.trajectory.frames();
+  const int begin = r.frame_begin, end = r.frame_end < 0 ? F : r.frame_end;
+  if (begin < 0 || begin >= F || end <= begin || end > F)
+    throw InputError("frames " + std::to_string(begin) + ":" + std::to_string(r.frame_end) + " out of range: " +
+                     r.run_dir.string() + " has frames 0.." + std::to_string(F - 1) + " (A:B exports A..B-1)");
+  Assimp::Exporter exporter;
+  bool available = false;
+  for (size_t k = 0; k < exporter.GetExportFormatCount(); ++k)
+    available = available || std::string(exporter.GetExportFormatDescription(k)->id) == format->assimp_id;
+  if (!available) throw InputError(std::string("this assimp has no \"") + format->assimp_id + "\" exporter");
+
+  const fs::path dir = r.run_dir / "export";
+  const fs::path partial = dir / (".partial_" + std::to_string(::getpid()));
+  std::error_code ec;
+  fs::remove_all(partial, ec);
+  ensure_directory(partial);
+  const Bounds bounds = scene_bounds(run.scene, run.trajectory, run.meshes ? &*run.meshes : nullptr);
+  FrameGeometry g;
+  char name[64];
+  auto write = [&](const aiScene& scene, const std::string& file) {
+    if (exporter.Export(&scene, format->assimp_id, (partial / file).string()) != aiReturn_SUCCESS) {
+      fs::remove_all(partial, ec);
+      throw OutputError((dir / file).string() + ": export failed (" + exporter.GetErrorString() + ")");
+    }
+  };
+  try {
+    if (format->one_file) {
+      std::vector<std::pair<std::string, std::vector<ExportMesh>>> groups;
+      for (int f = begin; f < end; ++f) {
+        std::snprintf(name, sizeof name, "frame_%04d", f);
+        groups.emplace_back(name, frame_meshes(run, f, bounds, g));
+      }
+      write(*make_scene(groups), run.scene.name + format->extension);
+    } else {
+      for (int f = begin; f < end; ++f) {
+        std::snprintf(name, sizeof name, "frame_%04d", f);
+        write(*make_scene({{name, frame_meshes(run, f, bounds, g)}}), name + std::string(format->extension));
+      }
+    }
+  } catch (...) {
+    fs::remove_all(partial, ec);
+    throw;
+  }
+  // Every file was written: only now do they replace what an earlier export left.
+  std::vector<fs::path> written;
+  for (const auto& e : fs::directory_iterator(partial)) {
+    const fs::path target = dir / e.path().filename();
+    fs::rename(e.path(), target, ec);
+    if (ec) throw OutputError(target.string() + ": cannot write (" + ec.message() + ")");
+    written.push_back(target);
+  }
+  fs::remove_all(partial, ec);
+  std::sort(written.begin(), written.end());
+  return written;
+}
+
+}  // namespace kf::render

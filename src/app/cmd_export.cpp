@@ -1,0 +1,40 @@
+// keyframe export RUN_DIR --format obj|ply|gltf2: the run's animated meshes for other tools.
+#include <iostream>
+#include <regex>
+
+#include "app/commands.h"
+#include "core/error.h"
+#include "render/export/export_run.h"
+
+namespace kf {
+
+void add_export_command(CLI::App& app) {
+  auto* sub = app.add_subcommand(
+      "export", "write the run's meshes per frame to RUN_DIR/export/ (OBJ or PLY per frame, or one glTF 2)");
+  auto req = std::make_shared<render::ExportRequest>();
+  auto frames = std::make_shared<std::string>();
+  std::string names;
+  for (const auto& n : render::export_format_names()) names += (names.empty() ? "" : "|") + n;
+  sub->add_option("RUN_DIR", req->run_dir, "run directory holding scene.json and trajectory.bin")->required();
+  sub->add_option("--format", req->format, "file format (" + names + "); gltf2 puts all frames in one file")
+      ->capture_default_str();
+  sub->add_option("--frames", *frames, "frames A:B exports A..B-1 (default: all)");
+  sub->footer("Meshes: \"cloth\" or \"agents\", plus each mesh of RUN_DIR/meshes.bin; metres, Y up.\n"
+              "Example: keyframe export out/ringtoss --format gltf2");
+  sub->callback([=] {
+    render::ExportRequest r = *req;
+    if (!frames->empty()) {
+      std::smatch m;
+      static const std::regex re(R"((\d{1,7})?(:)?(\d{1,7})?)");
+      if (!std::regex_match(*frames, m, re) || (!m[1].matched && !m[3].matched))
+        throw InputError("--frames: expected A:B (frames A..B-1), A: or A, got \"" + *frames + "\"");
+      r.frame_begin = m[1].matched ? std::stoi(m[1]) : 0;
+      r.frame_end = m[3].matched ? std::stoi(m[3]) : (m[2].matched ? -1 : r.frame_begin + 1);
+    }
+    const auto files = render::export_run(r);
+    std::cout << "exported " << files.size() << " file" << (files.size() == 1 ? "" : "s") << " -> "
+              << (r.run_dir / "export").string() << "\n";
+  });
+}
+
+}  // namespace kf
