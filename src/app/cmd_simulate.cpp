@@ -4,6 +4,7 @@
 
 #include "adjoint/rollout.h"
 #include "app/commands.h"
+#include "app/body_meshes.h"
 #include "app/run_dir.h"
 #include "core/error.h"
 #include "core/progress.h"
@@ -45,6 +46,7 @@ void add_simulate_command(CLI::App& app) {
                        " (reduce the time step or the stiffness)");
     prepare_run_dir(dir, scene);
     save_trajectory(dir / "trajectory.bin", frames_of(r, scene.time, sys->particles()));
+    write_body_meshes(scene, scene.time.frames + 1, dir / "meshes.bin");
     nlohmann::json report = {{"scene", scene.name}, {"command", "simulate"}, {"system", sys->describe()},
                              {"steps", scene.time.steps()}, {"frames", scene.time.frames + 1},
                              {"simulate_seconds", secs}};

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "app/plot.h"
+#include "app/body_meshes.h"
 #include "app/run_dir.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -147,6 +148,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   const Trajectory frames = frames_of(problem->rollout(), time, sys->particles());
   save_controls(dir / "controls.bin", z, time.substeps);
   save_trajectory(dir / "trajectory.bin", frames);
+  write_body_meshes(scene, frames.frames(), dir / "meshes.bin");
   if (!history.empty()) {
     write_history_csv(dir / "iterations.csv", history, history.front().rec.terms);
     plot_csv(dir / "iterations.csv", dir / "convergence.png", scene.name + ": objective and gradient norm", 1, {3, 4});
