@@ -15,10 +15,7 @@ bool polygon_contains(const std::vector<Vec2>& poly, const Vec2& q) {
   return inside;
 }
 
-Vec2 closest_point_in_polygon(const std::vector<Vec2>& poly, const Vec2& q, bool* inside) {
-  const bool in = polygon_contains(poly, q);
-  if (inside) *inside = in;
-  if (in) return q;
+Vec2 closest_point_on_boundary(const std::vector<Vec2>& poly, const Vec2& q) {
   double best = std::numeric_limits<double>::infinity();
   Vec2 best_p = q;
   for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
@@ -33,6 +30,13 @@ Vec2 closest_point_in_polygon(const std::vector<Vec2>& poly, const Vec2& q, bool
     }
   }
   return best_p;
+}
+
+Vec2 closest_point_in_polygon(const std::vector<Vec2>& poly, const Vec2& q, bool* inside) {
+  const bool in = polygon_contains(poly, q);
+  if (inside) *inside = in;
+  if (in) return q;
+  return closest_point_on_boundary(poly, q);
 }
 
 namespace {
@@ -96,27 +100,47 @@ class CenterOfMassTerm : public ObjectiveTerm {
   Vec3 target_;
 };
 
-// ½w Σ dist(x_i, S)² over agents outside a ground region S given as a polygon in (x, z).
+// ½w Σ max(0, s(x_i) + m)² over agents, s the signed distance to the boundary of a ground region S given
+// as a polygon in (x, z) (negative inside), m the margin: agents are pulled to at least m inside. With
+// m = 0 this is ½w Σ dist(x_i, S)² over agents outside. The gradient w (s + m) ∇s is continuous across the
+// boundary (∇s is the unit direction away from the closest boundary point, outward).
 class ShapeTerm : public ObjectiveTerm {
  public:
-  ShapeTerm(const ObjectiveSpec& s, int p) : frame_(s.frame), w_(s.weight), ids_(members(s, p)), poly_(s.polygon) {}
+  ShapeTerm(const ObjectiveSpec& s, int p)
+      : frame_(s.frame), w_(s.weight), margin_(s.margin), ids_(members(s, p)), poly_(s.polygon) {}
   std::string name() const override { return "shape"; }
   int frame() const override { return frame_; }
   double eval(const VecX& x, const VecX&, VecX& gx, VecX&) const override {
     double val = 0;
     for (int i : ids_) {
       const Vec2 q(x[3 * i], x[3 * i + 2]);
-      const Vec2 d = q - closest_point_in_polygon(poly_, q);
-      val += 0.5 * w_ * d.squaredNorm();
-      gx[3 * i] += w_ * d.x();
-      gx[3 * i + 2] += w_ * d.y();
+      bool inside = false;
+      const Vec2 c = closest_point_in_polygon(poly_, q, &inside);
+      Vec2 g;
+      if (!inside) {
+        g = q - c;  // (s + m) ∇s with s = |q - c|, m = 0; below for m > 0
+        if (margin_ > 0) {
+          const double s = g.norm();
+          if (s == 0) continue;
+          g *= (s + margin_) / s;
+        }
+      } else {
+        if (margin_ <= 0) continue;
+        const Vec2 away = closest_point_on_boundary(poly_, q) - q;  // inward distance, pointing out
+        const double depth = away.norm();
+        if (depth >= margin_ || depth == 0) continue;
+        g = (margin_ - depth) / depth * away;
+      }
+      val += 0.5 * w_ * g.squaredNorm();
+      gx[3 * i] += w_ * g.x();
+      gx[3 * i + 2] += w_ * g.y();
     }
     return val;
   }
 
  private:
   int frame_;
-  double w_;
+  double w_, margin_;
   std::vector<int> ids_;
   std::vector<Vec2> poly_;
 };

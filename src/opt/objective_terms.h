@@ -26,6 +26,8 @@ std::unique_ptr<ObjectiveTerm> make_objective_term(const ObjectiveSpec& spec, in
 // Geometry shared by terms and the figures' success measures.
 // Closest point of the closed polygon region (x, z) to q; returns q itself when q is inside.
 Vec2 closest_point_in_polygon(const std::vector<Vec2>& polygon, const Vec2& q, bool* inside = nullptr);
+// Closest point of the polygon's boundary (its edges) to q, inside or out.
+Vec2 closest_point_on_boundary(const std::vector<Vec2>& polygon, const Vec2& q);
 bool polygon_contains(const std::vector<Vec2>& polygon, const Vec2& q);
 
 }  // namespace kf

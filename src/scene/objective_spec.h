@@ -16,6 +16,7 @@ struct ObjectiveSpec {
   std::vector<int> particles;   // empty: all particles
   std::vector<Vec3> targets;    // position/velocity: one per listed particle (or one for all); com: one
   std::vector<Vec2> polygon;    // shape: closed polygon on the ground, (x, z), metres
+  double margin = 0;            // shape: agents are pulled at least this far inside (m)
   Vec3 axis_point = Vec3::Zero();  // arch: a point on the cylinder axis
   Vec3 axis = Vec3::UnitZ();       // arch: unit axis direction
   double radius = 1.0;             // arch: cylinder radius, metres

@@ -47,6 +47,7 @@ ObjectiveSpec parse_objective(Block b, const Scene& s) {
   } else if (o.type == "shape") {
     if (!flock) b.fail("type", "\"shape\" keyframes are for flocks; use \"position\" or \"arch\" for cloth");
     o.polygon = b.points2("polygon", 3);
+    o.margin = b.number("margin", 0.0, 0.0, 1e4);
   } else if (o.type == "arch") {
     if (flock) b.fail("type", "\"arch\" keyframes are for cloth");
     o.axis_point = b.vec3("axis_point");

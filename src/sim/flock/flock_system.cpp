@@ -5,31 +5,28 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "sim/flock/avoidance_force.h"
-#include "sim/flock/centering_force.h"
 #include "sim/flock/drag_force.h"
 #include "sim/flock/flock_spawn.h"
-#include "sim/flock/matching_force.h"
 #include "sim/flock/parallel_agents.h"
 #include "sim/flock/wander_force.h"
 #include "sim/make_system.h"
 
 namespace kf {
 
+namespace {
+// Records hold ~(4 + neighbours) numbers per agent and step; beyond this many agent-steps the adjoint
+// recomputes its neighbour search instead.
+constexpr long kMaxRecordedAgentSteps = 4'000'000;
+}  // namespace
+
 FlockSystem::FlockSystem(const FlockSpec& spec, double h, int steps, unsigned seed, double h_ref)
-    : spec_(spec), h_(h), seed_(seed), masses_(VecX::Constant(spec.agents, spec.mass)) {
-  if (spec.avoidance.strength > 0)
-    forces_.push_back(std::make_unique<AvoidanceForce>(AvoidanceParams{spec.avoidance.strength, spec.avoidance.radius}));
-  if (spec.matching.strength > 0)
-    forces_.push_back(std::make_unique<MatchingForce>(MatchingParams{spec.matching.strength, spec.matching.radius}));
-  if (spec.centering.strength > 0)
-    forces_.push_back(std::make_unique<CenteringForce>(CenteringParams{spec.centering.strength, spec.centering.radius}));
+    : spec_(spec), h_(h), seed_(seed), masses_(VecX::Constant(spec.agents, spec.mass)), neighbor_forces_(spec) {
   if (spec.wander.strength > 0) {
     const WanderParams w{spec.wander.strength, spec.wander.correlation_steps, seed, h_ref > 0 ? h / h_ref : 1.0};
-    forces_.push_back(std::make_unique<WanderForce>(w, spec.agents, steps));
+    local_forces_.push_back(std::make_unique<WanderForce>(w, spec.agents, steps));
   }
-  if (spec.drag.strength > 0) forces_.push_back(std::make_unique<DragForce>(spec.drag.strength));
-  for (const auto& f : forces_) neighbor_radius_ = std::max(neighbor_radius_, f->radius());
+  if (spec.drag.strength > 0) local_forces_.push_back(std::make_unique<DragForce>(spec.drag.strength));
+  if (long(steps) * spec.agents <= kMaxRecordedAgentSteps) cached_steps_ = std::max(steps, 0);
   y_.resize(dof());
 }
 
@@ -39,23 +36,61 @@ void FlockSystem::initial_state(VecX& x, VecX& v) const {
   for (int i = 0; i < spec_.agents; ++i) seg(v, i) = spec_.spawn.velocity;
 }
 
-FlockState FlockSystem::prepare(int n, const VecX& x, const VecX& v) {
+void FlockSystem::check_size(const VecX& x, const VecX& v) const {
   if (x.size() != dof() || v.size() != dof())
     throw std::invalid_argument("flock state has " + std::to_string(x.size()) + " entries, expected " +
                                 std::to_string(dof()));
-  if (neighbor_radius_ > 0) grid_.build(x, neighbor_radius_);  // else no force reads neighbours
-  FlockState s{n, x, v, grid_};
-  for (auto& f : forces_) f->prepare(s);
-  return s;
+}
+
+FlockSystem::StepRecord& FlockSystem::record_for(int n) {
+  if (n < 0 || n >= cached_steps_) return scratch_;
+  if (records_.size() < size_t(cached_steps_)) records_.resize(cached_steps_);
+  return records_[n];
+}
+
+void FlockSystem::search(StepRecord& r, const VecX& x, bool with_centering) {
+  const int p = spec_.agents;
+  if (r.offset.size() != dof()) {
+    r.offset.resize(dof());
+    r.b.resize(p);
+  }
+  r.x = x;
+  if (!neighbor_forces_.any()) {
+    r.offset.setZero();
+    std::fill(r.b.begin(), r.b.end(), 1.0);
+    return;
+  }
+  r.grid.build(x, neighbor_forces_.radius());
+  if (with_centering)
+    parallel_agents(p, [&](int i) {
+      Vec3 o;
+      neighbor_forces_.centering(x, r.grid.neighbors(i), i, o, r.b[i]);
+      seg(r.offset, i) = o;
+    });
+}
+
+Vec3 FlockSystem::local_force(int n, const VecX& v, int i) const {
+  // Wander and drag read neither neighbours nor x; FlockState is only their calling convention.
+  static const NeighborGrid kNoGrid;
+  const FlockState s{n, v, v, kNoGrid};
+  Vec3 f = Vec3::Zero();
+  for (const auto& force : local_forces_) force->add_force(s, i, f);
+  return f;
 }
 
 bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) {
-  const FlockState s = prepare(n, x, v);
+  check_size(x, v);
+  StepRecord& r = record_for(n);
+  search(r, x, false);
   x_next.resize(dof());
   v_next.resize(dof());
   parallel_agents(spec_.agents, [&](int i) {
-    Vec3 f = seg(u, i);
-    for (const auto& force : forces_) force->add_force(s, i, f);
+    Vec3 f = seg(u, i) + local_force(n, v, i);
+    if (neighbor_forces_.any()) {
+      Vec3 o;
+      f += neighbor_forces_.force(x, v, r.grid.neighbors(i), i, o, r.b[i]);
+      seg(r.offset, i) = o;
+    }
     Vec3 v1 = seg(v, i) + (h_ / masses_[i]) * f;
     v1.y() = 0;
     Vec3 x1 = seg(x, i) + h_ * v1;
@@ -66,9 +101,20 @@ bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
   return x_next.allFinite() && v_next.allFinite();
 }
 
+void FlockSystem::transpose_apply(const StepRecord& r, int n, const VecX& x, const VecX& v, const VecX& y, int j,
+                                  Vec3& kt, Vec3& dt) const {
+  kt.setZero();
+  dt.setZero();
+  if (neighbor_forces_.any())
+    neighbor_forces_.transpose_apply(x, v, y, r.grid.neighbors(j), j, r.offset, r.b, kt, dt);
+  if (spec_.drag.strength > 0) dt -= spec_.drag.strength * seg(y, j);
+}
+
 void FlockSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const VecX& xhat1,
                                const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) {
-  const FlockState s = prepare(n, x, v);
+  check_size(x, v);
+  StepRecord& r = record_for(n);
+  if (r.x.size() != x.size() || r.x != x) search(r, x, true);  // not the state the forward step saw
   const int p = spec_.agents;
   // The step writes y = 0 whatever its inputs, so the y parts of xhat1 and vhat1 flow nowhere.
   parallel_agents(p, [&](int i) {
@@ -80,11 +126,8 @@ void FlockSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& 
   vhat.resize(dof());
   uhat.resize(dof());
   parallel_agents(p, [&](int j) {
-    Vec3 kt = Vec3::Zero(), dt = Vec3::Zero();
-    for (const auto& force : forces_) {
-      force->add_KT(s, y_, j, kt);
-      force->add_DT(s, y_, j, dt);
-    }
+    Vec3 kt, dt;
+    transpose_apply(r, n, x, v, y_, j, kt, dt);
     const Vec3 yj = seg(y_, j);
     Vec3 xh = seg(xhat1, j) + h_ * kt;
     Vec3 vh = seg(vhat1, j) + h_ * seg(xhat1, j) + h_ * dt;  // s_j + h (D^T M^-1 s)_j
@@ -97,25 +140,28 @@ void FlockSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& 
 }
 
 void FlockSystem::forces(int n, const VecX& x, const VecX& v, VecX& f) {
-  const FlockState s = prepare(n, x, v);
+  check_size(x, v);
+  search(scratch_, x, false);
   f.resize(dof());
   parallel_agents(spec_.agents, [&](int i) {
-    Vec3 fi = Vec3::Zero();
-    for (const auto& force : forces_) force->add_force(s, i, fi);
+    Vec3 fi = local_force(n, v, i);
+    if (neighbor_forces_.any()) {
+      Vec3 o;
+      fi += neighbor_forces_.force(x, v, scratch_.grid.neighbors(i), i, o, scratch_.b[i]);
+      seg(scratch_.offset, i) = o;
+    }
     seg(f, i) = fi;
   });
 }
 
 void FlockSystem::apply_KT_DT(int n, const VecX& x, const VecX& v, const VecX& y, VecX& KTy, VecX& DTy) {
-  const FlockState s = prepare(n, x, v);
+  check_size(x, v);
+  search(scratch_, x, true);
   KTy.resize(dof());
   DTy.resize(dof());
   parallel_agents(spec_.agents, [&](int j) {
-    Vec3 kt = Vec3::Zero(), dt = Vec3::Zero();
-    for (const auto& force : forces_) {
-      force->add_KT(s, y, j, kt);
-      force->add_DT(s, y, j, dt);
-    }
+    Vec3 kt, dt;
+    transpose_apply(scratch_, n, x, v, y, j, kt, dt);
     seg(KTy, j) = kt;
     seg(DTy, j) = dt;
   });
@@ -124,9 +170,14 @@ void FlockSystem::apply_KT_DT(int n, const VecX& x, const VecX& v, const VecX& y
 std::string FlockSystem::describe() const {
   std::ostringstream os;
   os << "flock: " << spec_.agents << " agents, mass " << spec_.mass << " kg, forces:";
-  if (forces_.empty()) os << " none";
-  for (size_t k = 0; k < forces_.size(); ++k) os << (k ? ", " : " ") << forces_[k]->name();
-  os << "; grid neighbour search, radius " << neighbor_radius_ << " m";
+  std::vector<std::string> names;
+  if (spec_.avoidance.strength > 0) names.push_back("avoidance");
+  if (spec_.matching.strength > 0) names.push_back("matching");
+  if (spec_.centering.strength > 0) names.push_back("centering");
+  for (const auto& f : local_forces_) names.push_back(f->name());
+  if (names.empty()) os << " none";
+  for (size_t k = 0; k < names.size(); ++k) os << (k ? ", " : " ") << names[k];
+  os << "; grid neighbour search, radius " << neighbor_forces_.radius() << " m";
   return os.str();
 }
 

@@ -3,13 +3,18 @@
 //
 //   v1 = v + h M^-1 (f(x, v) + u),  x1 = x + h v1          (forward)
 //   s = vhat1 + h xhat1,  xhat = xhat1 + h K^T M^-1 s,  vhat = s + h D^T M^-1 s,  uhat = h M^-1 s
-// with K = df/dx, D = df/dv recomputed at (x_n, v_n) in the backward pass and applied matrix-free.
+// with K = df/dx, D = df/dv at (x_n, v_n) applied matrix-free. The three neighbour forces run fused in one
+// pass over each agent's list (NeighborForces); wander and drag are per-agent terms.
+// The forward step records, per step, the neighbour lists and centering means it found; the adjoint step
+// at the same step reuses them when its x is bit-identical to the recorded one (as in a rollout's
+// backward pass), so one adjoint step costs one transposed pass and no neighbour search.
 // Planar: the y components of x1, v1 and of every adjoint output are exactly zero (y of u is ignored).
 #include <memory>
 #include <vector>
 
 #include "scene/flock_spec.h"
 #include "sim/flock/flock_force.h"
+#include "sim/flock/neighbor_forces.h"
 #include "sim/flock/neighbor_grid.h"
 #include "sim/system.h"
 
@@ -38,16 +43,32 @@ class FlockSystem final : public System {
   void apply_KT_DT(int n, const VecX& x, const VecX& v, const VecX& y, VecX& KTy, VecX& DTy);
 
  private:
-  // Neighbours and per-agent force data at (x, v).
-  FlockState prepare(int n, const VecX& x, const VecX& v);
+  // What the forward step found at one state: neighbours and centering quantities (offset 3p, b p).
+  struct StepRecord {
+    VecX x;  // the positions it belongs to (empty: none)
+    NeighborGrid grid;
+    VecX offset;
+    std::vector<double> b;
+  };
+  // The record for step n (a scratch one for steps beyond the cached range).
+  StepRecord& record_for(int n);
+  // Fills `r` for x: neighbour search, and the centering quantities when `with_centering`.
+  void search(StepRecord& r, const VecX& x, bool with_centering);
+  void check_size(const VecX& x, const VecX& v) const;
+  // (K^T y)_j and (D^T y)_j of all forces at the state of record r.
+  void transpose_apply(const StepRecord& r, int n, const VecX& x, const VecX& v, const VecX& y, int j, Vec3& kt,
+                       Vec3& dt) const;
+  Vec3 local_force(int n, const VecX& v, int i) const;  // wander + drag on agent i
 
   FlockSpec spec_;
   double h_;
   unsigned seed_;
   VecX masses_;
-  std::vector<std::unique_ptr<FlockForce>> forces_;
-  double neighbor_radius_ = 0;
-  NeighborGrid grid_;
+  NeighborForces neighbor_forces_;
+  std::vector<std::unique_ptr<FlockForce>> local_forces_;  // per-agent terms: wander, drag
+  std::vector<StepRecord> records_;
+  int cached_steps_ = 0;
+  StepRecord scratch_;
   VecX y_;  // M^-1 s in the adjoint step
 };
 

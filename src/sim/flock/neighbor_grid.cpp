@@ -60,7 +60,6 @@ void NeighborGrid::build(const VecX& x, double radius) {
     bucket_cursor_.assign(buckets, 0);
     sorted_.assign(p, 0);
     neighbor_count_.assign(p, 0);
-    neighbor_start_.assign(p + 1, 0);
   }
   const double inv_cell = 1.0 / radius;
   parallel_agents(p, [&](int i) {
@@ -76,18 +75,25 @@ void NeighborGrid::build(const VecX& x, double radius) {
   std::copy(bucket_start_.begin(), bucket_start_.end() - 1, bucket_cursor_.begin());
   for (int i = 0; i < p; ++i) sorted_[bucket_cursor_[bucket_of(cell_x_[i], cell_z_[i])]++] = i;
 
-  parallel_agents(p, [&](int i) {
-    int n = 0;
-    for_each_neighbor(x, i, [&](int) { ++n; });
-    neighbor_count_[i] = n;
-  });
-  neighbor_start_[0] = 0;
-  for (int i = 0; i < p; ++i) neighbor_start_[i + 1] = neighbor_start_[i] + neighbor_count_[i];
-  if (size_t(neighbor_start_[p]) > neighbors_.size()) neighbors_.resize(size_t(neighbor_start_[p]) * 3 / 2 + 16);
-  parallel_agents(p, [&](int i) {
-    int k = neighbor_start_[i];
-    for_each_neighbor(x, i, [&](int j) { neighbors_[k++] = j; });
-  });
+  // One pass: each agent writes into its own slab of `capacity_` entries; in the rare step where some
+  // agent has more neighbours than ever before, the slabs grow and the pass runs again.
+  if (capacity_ == 0) capacity_ = 16;
+  for (;;) {
+    if (neighbors_.size() < size_t(p) * capacity_) neighbors_.resize(size_t(p) * capacity_);
+    parallel_agents(p, [&](int i) {
+      int* out = neighbors_.data() + size_t(i) * capacity_;
+      int n = 0;
+      const int cap = capacity_;
+      for_each_neighbor(x, i, [&](int j) {
+        if (n < cap) out[n] = j;
+        ++n;
+      });
+      neighbor_count_[i] = n;
+    });
+    const int most = p ? *std::max_element(neighbor_count_.begin(), neighbor_count_.end()) : 0;
+    if (most <= capacity_) break;
+    capacity_ = most + most / 2 + 4;
+  }
 }
 
 }  // namespace kf

@@ -3,8 +3,8 @@
 //
 // Cells are `radius` wide in x and z and hashed into a table of ~2p buckets (filled by a counting sort),
 // so memory is linear in agents however far the flock spreads. Cost is linear in agents at bounded
-// density. After the first build with a given p nothing is allocated, except that the neighbour array
-// grows (amortised) if the flock becomes denser than ever before.
+// density. After the first build with a given p nothing is allocated, except that the per-agent
+// neighbour slabs grow (amortised) if the flock becomes denser than ever before.
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -19,9 +19,9 @@ class NeighborGrid {
   // in an order that depends only on x (not on the thread count).
   void build(const VecX& x, double radius);
 
-  int agents() const { return int(neighbor_start_.size()) - 1; }
+  int agents() const { return int(neighbor_count_.size()); }
   std::span<const int> neighbors(int i) const {
-    return {neighbors_.data() + neighbor_start_[i], size_t(neighbor_start_[i + 1] - neighbor_start_[i])};
+    return {neighbors_.data() + size_t(i) * capacity_, size_t(neighbor_count_[i])};
   }
   double radius() const { return radius_; }
 
@@ -37,8 +37,8 @@ class NeighborGrid {
   std::vector<int> bucket_cursor_;        // buckets
   std::vector<int> sorted_;               // agents ordered by bucket
   std::vector<int> neighbor_count_;       // per agent
-  std::vector<int> neighbor_start_;       // p + 1
-  std::vector<int> neighbors_;
+  int capacity_ = 0;                      // neighbour slots per agent
+  std::vector<int> neighbors_;            // p slabs of capacity_ entries
 };
 
 }  // namespace kf

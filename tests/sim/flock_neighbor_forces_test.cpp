@@ -1,0 +1,96 @@
+// The fused neighbour pass (NeighborForces) against the three force terms it fuses, evaluated one by one,
+// and the record reuse of the flock's adjoint step.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "sim/flock/avoidance_force.h"
+#include "sim/flock/centering_force.h"
+#include "sim/flock/flock_system.h"
+#include "sim/flock/matching_force.h"
+#include "sim/flock/neighbor_forces.h"
+
+namespace kf {
+namespace {
+
+VecX random_planar(int p, double scale, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-scale, scale);
+  VecX r = VecX::Zero(3 * p);
+  for (int i = 0; i < p; ++i) r[3 * i] = u(rng), r[3 * i + 2] = u(rng);
+  return r;
+}
+
+TEST(NeighborForces, EqualsTheSeparateTermsForwardAndTransposed) {
+  const int p = 60;
+  std::mt19937_64 rng(9);
+  const VecX x = random_planar(p, 4.0, rng), v = random_planar(p, 1.0, rng), y = random_planar(p, 1.0, rng);
+  FlockSpec spec;
+  spec.agents = p;
+  spec.avoidance = {6.0, 1.5};
+  spec.matching = {0.5, 2.5};
+  spec.centering = {1.0, 3.5};  // every radius different
+  NeighborForces fused(spec);
+  ASSERT_EQ(fused.radius(), 3.5);
+  NeighborGrid grid;
+  grid.build(x, fused.radius());
+  AvoidanceForce avoid({6.0, 1.5});
+  MatchingForce match({0.5, 2.5});
+  CenteringForce centre({1.0, 3.5});
+  const FlockState s{0, x, v, grid};
+  centre.prepare(s);
+  VecX offset(3 * p);
+  std::vector<double> b(p);
+  double largest = 0;
+  for (int i = 0; i < p; ++i) {
+    Vec3 o, f_ref = Vec3::Zero();
+    const Vec3 f = fused.force(x, v, grid.neighbors(i), i, o, b[i]);
+    seg(offset, i) = o;
+    avoid.add_force(s, i, f_ref);
+    match.add_force(s, i, f_ref);
+    centre.add_force(s, i, f_ref);
+    largest = std::max(largest, f_ref.norm());
+    EXPECT_LT((f - f_ref).norm(), 1e-12 * (1 + f_ref.norm())) << "agent " << i;
+  }
+  ASSERT_GT(largest, 0.1);
+  for (int j = 0; j < p; ++j) {
+    Vec3 kt = Vec3::Zero(), dt = Vec3::Zero(), kt_ref = Vec3::Zero(), dt_ref = Vec3::Zero();
+    fused.transpose_apply(x, v, y, grid.neighbors(j), j, offset, b, kt, dt);
+    avoid.add_KT(s, y, j, kt_ref);
+    match.add_KT(s, y, j, kt_ref);
+    centre.add_KT(s, y, j, kt_ref);
+    match.add_DT(s, y, j, dt_ref);
+    EXPECT_LT((kt - kt_ref).norm(), 1e-11 * (1 + kt_ref.norm())) << "agent " << j;
+    EXPECT_LT((dt - dt_ref).norm(), 1e-11 * (1 + dt_ref.norm())) << "agent " << j;
+  }
+}
+
+TEST(FlockSystem, AdjointStepIsTheSameWithAndWithoutTheForwardRecord) {
+  const int p = 30;
+  FlockSpec spec;
+  spec.agents = p;
+  spec.spawn.radius = 4;
+  spec.spawn.velocity = Vec3(0.5, 0, 1);
+  std::mt19937_64 rng(2);
+  VecX x, v;
+  FlockSystem a(spec, 1.0 / 30, 10, 3), b(spec, 1.0 / 30, 10, 3);
+  a.initial_state(x, v);
+  x += random_planar(p, 0.3, rng);
+  const VecX u = random_planar(p, 0.5, rng), xh1 = random_planar(p, 1, rng), vh1 = random_planar(p, 1, rng);
+  VecX x1, v1, xa, va, ua, xb, vb, ub;
+  ASSERT_TRUE(a.step(4, x, v, u, x1, v1));  // a records step 4; b has never seen it
+  a.step_adjoint(4, x, v, u, xh1, vh1, xa, va, ua);
+  b.step_adjoint(4, x, v, u, xh1, vh1, xb, vb, ub);
+  ASSERT_GT(xa.norm(), 0);
+  EXPECT_EQ(xa, xb);
+  EXPECT_EQ(va, vb);
+  EXPECT_EQ(ua, ub);
+  // A different state at the same step must not reuse the record.
+  VecX x2 = x;
+  x2[0] += 0.05;
+  a.step_adjoint(4, x2, v, u, xh1, vh1, xa, va, ua);
+  b.step_adjoint(4, x2, v, u, xh1, vh1, xb, vb, ub);
+  EXPECT_EQ(xa, xb);
+}
+
+}  // namespace
+}  // namespace kf
