@@ -142,9 +142,9 @@ const BadScene kBadScenes[] = {
 
 void PrintTo(const BadScene& c, std::ostream* os) { *os << c.name; }
 
-class MalformedScene : public TempDirTest, public ::testing::WithParamInterface<BadScene> {};
+class BadSceneCli : public TempDirTest, public ::testing::WithParamInterface<BadScene> {};
 
-TEST_P(MalformedScene, GivesItsOneLineMessageAndWritesNothing) {
+TEST_P(BadSceneCli, GivesItsOneLineMessageAndWritesNothing) {
   const BadScene& c = GetParam();
   write("s.json", c.scene);
   const auto before = list_tree(dir_);
@@ -154,10 +154,12 @@ TEST_P(MalformedScene, GivesItsOneLineMessageAndWritesNothing) {
   EXPECT_EQ(list_tree(dir_), before) << c.command << " wrote something for a bad scene";
 }
 
-INSTANTIATE_TEST_SUITE_P(Reliability, MalformedScene, ::testing::ValuesIn(kBadScenes),
+INSTANTIATE_TEST_SUITE_P(Reliability, BadSceneCli, ::testing::ValuesIn(kBadScenes),
                          [](const auto& info) { return std::string(info.param.name); });
 
-class MalformedRun : public TempDirTest {
+class OtherBadInputCli : public TempDirTest {};
+
+class BadRunDirCli : public TempDirTest {
  protected:
   // A real run directory made by `simulate` of a small flock.
   fs::path make_run() {
@@ -175,23 +177,23 @@ class MalformedRun : public TempDirTest {
   }
 };
 
-TEST_F(MalformedRun, MissingRunDirectory) {
+TEST_F(BadRunDirCli, MissingRunDirectory) {
   expect_render_fails("nowhere", kExitInput, "nowhere: not a run directory (does not exist)");
 }
 
-TEST_F(MalformedRun, RunDirectoryWithoutScene) {
+TEST_F(BadRunDirCli, RunDirectoryWithoutScene) {
   fs::create_directories(dir_ / "empty");
   expect_render_fails("empty", kExitInput, "empty: not a run directory (no scene.json)");
 }
 
-TEST_F(MalformedRun, MissingTrajectory) {
+TEST_F(BadRunDirCli, MissingTrajectory) {
   const fs::path run = make_run();
   fs::remove(run / "trajectory.bin");
   expect_render_fails("run", kExitInput,
                       "run: no trajectory.bin to render (run 'keyframe simulate' or 'keyframe run' first)");
 }
 
-TEST_F(MalformedRun, TruncatedTrajectory) {
+TEST_F(BadRunDirCli, TruncatedTrajectory) {
   const fs::path run = make_run();
   const auto size = fs::file_size(run / "trajectory.bin");
   fs::resize_file(run / "trajectory.bin", size - 8);
@@ -199,19 +201,19 @@ TEST_F(MalformedRun, TruncatedTrajectory) {
                       "run/trajectory.bin: truncated or padded (expected " + std::to_string(size) + " bytes)");
 }
 
-TEST_F(MalformedRun, TrajectoryTruncatedInsideHeader) {
+TEST_F(BadRunDirCli, TrajectoryTruncatedInsideHeader) {
   const fs::path run = make_run();
   fs::resize_file(run / "trajectory.bin", 10);
   expect_render_fails("run", kExitInput, "run/trajectory.bin: not a keyframe trajectory (bad header)");
 }
 
-TEST_F(MalformedRun, TrajectoryInAnotherFormat) {
+TEST_F(BadRunDirCli, TrajectoryInAnotherFormat) {
   const fs::path run = make_run();
   write_text(run / "trajectory.bin", "\x89PNG\r\n\x1a\n this is an image, not a trajectory");
   expect_render_fails("run", kExitInput, "run/trajectory.bin: not a keyframe trajectory (bad header)");
 }
 
-TEST_F(MalformedRun, TrajectoryOfAnotherScene) {
+TEST_F(BadRunDirCli, TrajectoryOfAnotherScene) {
   // A trajectory of 12 agents next to a scene of 3: the header is fine, the particle count is not.
   const fs::path run = make_run();
   write("g.json", R"({"time": {"frames": 4}, "flock": {"agents": 3}})");
@@ -222,7 +224,7 @@ TEST_F(MalformedRun, TrajectoryOfAnotherScene) {
   EXPECT_FALSE(fs::exists(run / "frames")) << r.output;
 }
 
-TEST_F(MalformedRun, CorruptSceneCopy) {
+TEST_F(BadRunDirCli, CorruptSceneCopy) {
   const fs::path run = make_run();
   write_text(run / "scene.json", "{\"flock\": ");
   expect_render_fails("run", kExitInput,
@@ -230,19 +232,19 @@ TEST_F(MalformedRun, CorruptSceneCopy) {
                       "parsing value - unexpected end of input; expected '[', '{', or a literal");
 }
 
-TEST_F(MalformedRun, BadSizeOption) {
+TEST_F(BadRunDirCli, BadSizeOption) {
   const fs::path run = make_run();
   expect_render_fails("run --size 64by48", kExitInput, "--size: expected WxH such as 1280x720, got \"64by48\"");
 }
 
-TEST_F(MalformedRun, FramesPastTheEnd) {
+TEST_F(BadRunDirCli, FramesPastTheEnd) {
   const fs::path run = make_run();
   const CliResult r = run_keyframe("render run --frames 7:9", dir_);
   EXPECT_EQ(r.code, kExitInput) << r.output;
   EXPECT_FALSE(fs::exists(run / "frames"));
 }
 
-class UnwritableOutput : public TempDirTest {
+class UnwritableOutputCli : public TempDirTest {
  protected:
   void SetUp() override {
     TempDirTest::SetUp();
@@ -269,7 +271,7 @@ class UnwritableOutput : public TempDirTest {
   std::string why_;
 };
 
-TEST_F(UnwritableOutput, FileWhereTheRunDirectoryShouldBe) {
+TEST_F(UnwritableOutputCli, FileWhereTheRunDirectoryShouldBe) {
   write("taken", "a file, not a directory");
   const CliResult r = run_keyframe("simulate f.json --out taken/run", dir_);
   EXPECT_EQ(r.code, kExitOutput) << r.output;
@@ -278,7 +280,7 @@ TEST_F(UnwritableOutput, FileWhereTheRunDirectoryShouldBe) {
   EXPECT_EQ(read_text(dir_ / "taken"), "a file, not a directory");
 }
 
-TEST_F(UnwritableOutput, RunDirectoryIsAFile) {
+TEST_F(UnwritableOutputCli, RunDirectoryIsAFile) {
   write("taken", "a file, not a directory");
   const CliResult r = run_keyframe("optimize f.json --quiet --out taken", dir_);
   EXPECT_EQ(r.code, kExitOutput) << r.output;
@@ -286,7 +288,7 @@ TEST_F(UnwritableOutput, RunDirectoryIsAFile) {
   EXPECT_EQ(read_text(dir_ / "taken"), "a file, not a directory");
 }
 
-TEST_F(UnwritableOutput, ReadOnlyDirectory) {
+TEST_F(UnwritableOutputCli, ReadOnlyDirectory) {
   // Root ignores permission bits, so a read-only mount is the honest test; chmod is the fallback.
   fs::path ro;
   if (mount_tmpfs("ro", "ro,size=64k")) {
@@ -303,7 +305,7 @@ TEST_F(UnwritableOutput, ReadOnlyDirectory) {
   EXPECT_TRUE(list_tree(ro).empty());
 }
 
-TEST_F(UnwritableOutput, DiskFullLeavesNoPartialFiles) {
+TEST_F(UnwritableOutputCli, DiskFullLeavesNoPartialFiles) {
   if (!mount_tmpfs("small", "size=64k"))
     GTEST_SKIP() << "cannot mount a 64 KiB tmpfs to fill up (" << why_ << "); needs root";
   // 200 agents x 41 frames x 48 bytes is ~390 KiB of trajectory: cannot fit.
@@ -317,7 +319,7 @@ TEST_F(UnwritableOutput, DiskFullLeavesNoPartialFiles) {
   }
 }
 
-TEST_F(UnwritableOutput, DiskFullDuringOptimize) {
+TEST_F(UnwritableOutputCli, DiskFullDuringOptimize) {
   if (!mount_tmpfs("small", "size=64k"))
     GTEST_SKIP() << "cannot mount a 64 KiB tmpfs to fill up (" << why_ << "); needs root";
   write("big.json", R"({"time": {"frames": 40}, "flock": {"agents": 200, "spawn": {"radius": 10}},
@@ -330,20 +332,20 @@ TEST_F(UnwritableOutput, DiskFullDuringOptimize) {
   for (const auto& f : list_tree(mount_)) EXPECT_EQ(f.find(".tmp"), std::string::npos) << "temp file left: " << f;
 }
 
-TEST_F(UnwritableOutput, DevFullAsRunDirectory) {
+TEST_F(UnwritableOutputCli, DevFullAsRunDirectory) {
   const CliResult r = run_keyframe("simulate f.json --out /dev/full", dir_);
   EXPECT_EQ(r.code, kExitOutput) << r.output;
   EXPECT_EQ(r.output.rfind("keyframe: error: /dev/full: cannot create directory", 0), 0u) << r.output;
 }
 
-TEST_F(TempDirTest, BadThreadCountIsAUsageError) {
+TEST_F(OtherBadInputCli, BadThreadCountIsAUsageError) {
   write("f.json", small_flock_scene(4));
   const CliResult r = run_keyframe("--threads -3 simulate f.json", dir_);
   EXPECT_EQ(r.code, kExitUsage) << r.output;
   EXPECT_FALSE(fs::exists(dir_ / "out"));
 }
 
-TEST_F(TempDirTest, SceneThatIsADirectory) {
+TEST_F(OtherBadInputCli, SceneThatIsADirectory) {
   fs::create_directories(dir_ / "d.json");
   const CliResult r = run_keyframe("simulate d.json", dir_);
   EXPECT_EQ(r.code, kExitInput) << r.output;
