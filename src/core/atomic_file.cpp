@@ -35,8 +35,17 @@ void write_stream_atomic(const fs::path& path, const std::function<void(std::ost
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw OutputError(path.string() + ": cannot open for writing");
-    fill(out);
+    try {
+      fill(out);
+    } catch (...) {
+      out.close();
+      std::error_code ec;
+      fs::remove(tmp, ec);
+      throw;
+    }
     out.flush();
+    // close() can report the failure too (the last buffered bytes are written there).
+    if (out) out.close();
     if (!out) {
       out.close();
       std::error_code ec;
