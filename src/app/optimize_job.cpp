@@ -68,6 +68,7 @@ fs::path optimize_job(const fs::path& scene_file, const OptimizeOptions& opt) {
   auto sys = make_system(scene);
   const fs::path dir = run_dir_for(scene, opt.out);
   Problem problem(scene, scene.time, *sys);
+  if (opt.checkpoint_every >= 0) problem.set_checkpoint_every(opt.checkpoint_every);
   OptimizerSpec spec = scene.optimizer;
   if (opt.max_evaluations >= 0) spec.max_evaluations = opt.max_evaluations;
   prepare_run_dir(dir, scene);
@@ -109,6 +110,7 @@ fs::path optimize_job(const fs::path& scene_file, const OptimizeOptions& opt) {
                            {"controls", problem.controls().kind()},
                            {"control_variables", problem.size()},
                            {"steps", scene.time.steps()},
+                           {"checkpoint_every", problem.checkpoint_every()},
                            {"status", res.status},
                            {"interrupted", res.interrupted},
                            {"evaluations", res.evaluations},

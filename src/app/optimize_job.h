@@ -9,6 +9,7 @@ struct OptimizeOptions {
   std::string out;            // run directory ("" = out/<scene>/)
   int max_evaluations = -1;   // override the scene's limit when >= 0
   bool quiet = false;         // no per-evaluation lines on stdout
+  int checkpoint_every = -1;  // override the scene's optimizer.checkpoint_every when >= 0
 };
 
 // Returns the run directory. Throws InputError/OutputError.

@@ -23,6 +23,14 @@ class Controls {
   void expand(const VecX& z, VecX& v0, std::vector<VecX>& U) const;
   // Chain rule back: dphi/dU and dphi/dv0 -> dphi/dz (overwrites dz).
   void gather(const std::vector<VecX>& dU, const VecX& dv0, VecX& dz) const;
+  // One step at a time (no per-step storage): the force of step n (3p, resized here) and the chain
+  // rule of one step's dphi/du_n (3p) added into dz (size()). Zero / nothing for initial velocities.
+  void force_at(const VecX& z, int n, VecX& u) const;
+  void add_step_gradient(int n, const VecX& uhat, VecX& dz) const;
+  // The initial velocities z gives (3p).
+  void initial_velocity(const VecX& z, VecX& v0) const;
+  // dphi/dv0 -> dphi/dz for initial-velocity control, added into dz (nothing for force controls).
+  void gather_initial_velocity(const VecX& dv0, VecX& dz) const;
   // Control effort ½α∫‖u‖²dt (forces) or ½α‖v0 − v0_scene‖² (initial velocities); adds its gradient.
   double effort(const VecX& z, VecX& dz) const;
 

@@ -31,6 +31,7 @@ struct OptimizerSpec {
   double ftol_rel = 1e-8;
   double max_seconds = 0;  // 0: no limit
   int memory = 10;         // L-BFGS vectors
+  int checkpoint_every = 0;  // adjoint pass keeps every k-th state and recomputes the rest; 0: keep all
 };
 
 }  // namespace kf

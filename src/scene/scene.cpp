@@ -73,6 +73,7 @@ OptimizerSpec parse_optimizer(Block b) {
   o.ftol_rel = b.number("ftol_rel", o.ftol_rel, 0.0, 1.0);
   o.max_seconds = b.number("max_seconds", o.max_seconds, 0.0, 1e7);
   o.memory = b.integer("memory", o.memory, 1, 100);
+  o.checkpoint_every = b.integer("checkpoint_every", o.checkpoint_every, 0, 10'000'000);
   b.finish();
   return o;
 }
