@@ -74,21 +74,21 @@ double Problem::evaluate(const VecX& z, VecX* grad) {
     phi_good_ = phi;
     return phi;
   }
-  // Diverged: a smooth bowl around the last good point, far above anything a good step gives.
-  const double scale = 1e6 + 1e3 * std::abs(phi_good_);
+  // Diverged: a smooth bowl around the last good point, far above anything a good step gives. Every
+  // quantity is formed so that huge trial controls (or a huge last good point) cannot overflow it.
+  const double scale = 1e6 + 1e3 * std::min(std::abs(phi_good_), 1e250);
   const VecX d = have_good_ ? VecX(z - z_good_) : VecX(z);
-  const double norm2 = 1.0 + std::max(1.0, z_good_.size() ? z_good_.squaredNorm() : 1.0);
+  const double r0 = std::hypot(1.0, std::max(1.0, z_good_.size() ? z_good_.stableNorm() : 1.0));
   breakdown_ = {{"diverged", 1.0}};
-  // t = |d| / sqrt(norm2) without overflow: huge trial controls from a line search stay finite.
-  const double t = d.allFinite() ? d.stableNorm() / std::sqrt(norm2) : INFINITY;
+  const double t = d.allFinite() ? d.stableNorm() / r0 : INFINITY;  // distance in units of r0
   constexpr double kT = 1e6;
   if (t <= kT) {
-    if (grad) *grad = (2.0 * scale / norm2) * d;
-    return scale * (1.0 + d.squaredNorm() / norm2);
+    if (grad) *grad = (2.0 * scale) * ((d / r0) / r0);
+    return scale * (1.0 + t * t);
   }
   // Beyond t = kT the bowl grows as log t (value and slope continuous at kT), so it never overflows.
   if (grad) {
-    if (std::isfinite(t)) *grad = (2.0 * scale * kT * kT / norm2) * ((d / t) / t);
+    if (std::isfinite(t)) *grad = (2.0 * scale * kT * kT) * ((((d / t) / t) / r0) / r0);
     else grad->setZero(z.size());
   }
   return scale * (1.0 + kT * kT * (1.0 + 2.0 * std::log(std::min(t, 1e300) / kT)));
