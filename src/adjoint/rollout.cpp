@@ -2,23 +2,69 @@
 
 namespace kf {
 
-bool simulate(System& sys, const VecX& x0, const VecX& v0, const std::vector<VecX>& U, Rollout& r) {
-  const int N = int(U.size());
+std::size_t Rollout::stored_bytes() const {
+  std::size_t b = 0;
+  for (const auto& s : x) b += sizeof(double) * s.size();
+  for (const auto& s : v) b += sizeof(double) * s.size();
+  for (const auto& s : context) b += sizeof(double) * s.size();
+  return b;
+}
+
+namespace {
+
+void ensure_size(VecX& a, int n) {
+  if (a.size() != n) a.resize(n);
+}
+
+}  // namespace
+
+bool simulate(System& sys, const VecX& x0, const VecX& v0, int N, const StepControl& u, Rollout& r,
+              const RolloutOptions& options) {
+  const int dof = int(x0.size()), every = options.checkpoint_every;
   r.x.resize(N + 1);
   r.v.resize(N + 1);
+  r.every = every;
+  r.diverged_at = -1;
+  auto keep = [&](int n) {
+    return every <= 0 || n % every == 0 || n == N || (options.keep_for && options.keep_for->active(n));
+  };
+  // Entries not kept are released, so a Rollout reused in checkpointed mode shrinks.
+  for (int n = 0; n <= N; ++n) {
+    if (keep(n)) {
+      ensure_size(r.x[n], dof);
+      ensure_size(r.v[n], dof);
+    } else {
+      r.x[n].resize(0);
+      r.v[n].resize(0);
+    }
+  }
+  r.context.resize(every > 0 ? (N + every - 1) / every + 1 : 0);
   r.x[0] = x0;
   r.v[0] = v0;
-  r.diverged_at = -1;
+  // States not kept alternate between two scratch pairs so a step never reads what it writes.
+  VecX scratch_x[2], scratch_v[2];
+  if (every > 0)
+    for (int k = 0; k < 2; ++k) {
+      scratch_x[k].resize(dof);
+      scratch_v[k].resize(dof);
+    }
+  const VecX *xc = &r.x[0], *vc = &r.v[0];
   for (int n = 0; n < N; ++n) {
-    // Sized once; later rollouts reuse the storage.
-    if (r.x[n + 1].size() != x0.size()) r.x[n + 1].resize(x0.size());
-    if (r.v[n + 1].size() != x0.size()) r.v[n + 1].resize(x0.size());
-    if (!sys.step(n, r.x[n], r.v[n], U[n], r.x[n + 1], r.v[n + 1])) {
+    if (every > 0 && n % every == 0) sys.save_step_context(n, r.context[n / every]);
+    VecX& xn = r.kept(n + 1) ? r.x[n + 1] : scratch_x[n & 1];
+    VecX& vn = r.kept(n + 1) ? r.v[n + 1] : scratch_v[n & 1];
+    if (!sys.step(n, *xc, *vc, u(n), xn, vn)) {
       r.diverged_at = n;
       return false;
     }
+    xc = &xn;
+    vc = &vn;
   }
   return true;
+}
+
+bool simulate(System& sys, const VecX& x0, const VecX& v0, const std::vector<VecX>& U, Rollout& r) {
+  return simulate(sys, x0, v0, int(U.size()), [&](int n) -> const VecX& { return U[n]; }, r);
 }
 
 double cost_value(const StateCost& cost, const Rollout& r) {
@@ -30,21 +76,46 @@ double cost_value(const StateCost& cost, const Rollout& r) {
   return phi;
 }
 
-void backward(System& sys, const Rollout& r, const std::vector<VecX>& U, const StateCost& cost,
-              std::vector<VecX>& dU, VecX& dx0, VecX& dv0) {
+void backward(System& sys, const Rollout& r, const StepControl& u, const StateCost& cost,
+              const StepControlGradient& du, VecX& dx0, VecX& dv0) {
   const int N = r.steps(), dof = int(r.x[0].size());
-  dU.resize(N);
-  VecX xhat = VecX::Zero(dof), vhat = VecX::Zero(dof), xhat_prev(dof), vhat_prev(dof);
+  const int every = r.every > 0 ? r.every : N + 1;
+  VecX xhat = VecX::Zero(dof), vhat = VecX::Zero(dof), xhat_prev(dof), vhat_prev(dof), uhat(dof);
   if (cost.active(N)) cost.eval(N, r.x[N], r.v[N], xhat, vhat);
-  for (int n = N - 1; n >= 0; --n) {
-    dU[n].resize(dof);
-    sys.step_adjoint(n, r.x[n], r.v[n], U[n], xhat, vhat, xhat_prev, vhat_prev, dU[n]);
-    xhat.swap(xhat_prev);
-    vhat.swap(vhat_prev);
-    if (cost.active(n)) cost.eval(n, r.x[n], r.v[n], xhat, vhat);
+  // Segment buffers: states k .. e-1 of the segment being walked back (checkpointed mode only).
+  std::vector<VecX> seg_x(r.every > 0 ? every : 0), seg_v(seg_x.size());
+  for (auto& s : seg_x) s.resize(dof);
+  for (auto& s : seg_v) s.resize(dof);
+  const int last_start = r.every > 0 ? ((N - 1) / every) * every : 0;
+  for (int k = last_start; k >= 0; k -= every) {
+    const int e = std::min(k + every, N);
+    auto state_x = [&](int n) -> const VecX& { return r.every > 0 ? seg_x[n - k] : r.x[n]; };
+    auto state_v = [&](int n) -> const VecX& { return r.every > 0 ? seg_v[n - k] : r.v[n]; };
+    if (r.every > 0) {
+      // Recompute states k+1 .. e-1 from the checkpoint, in the original step context.
+      seg_x[0] = r.x[k];
+      seg_v[0] = r.v[k];
+      sys.restore_step_context(k, r.context[k / every]);
+      for (int n = k; n + 1 < e; ++n) sys.step(n, seg_x[n - k], seg_v[n - k], u(n), seg_x[n - k + 1], seg_v[n - k + 1]);
+    }
+    for (int n = e - 1; n >= k; --n) {
+      sys.step_adjoint(n, state_x(n), state_v(n), u(n), xhat, vhat, xhat_prev, vhat_prev, uhat);
+      du(n, uhat);
+      xhat.swap(xhat_prev);
+      vhat.swap(vhat_prev);
+      if (cost.active(n)) cost.eval(n, state_x(n), state_v(n), xhat, vhat);
+    }
   }
   dx0 = xhat;
   dv0 = vhat;
+}
+
+void backward(System& sys, const Rollout& r, const std::vector<VecX>& U, const StateCost& cost,
+              std::vector<VecX>& dU, VecX& dx0, VecX& dv0) {
+  dU.resize(r.steps());
+  backward(
+      sys, r, [&](int n) -> const VecX& { return U[n]; }, cost, [&](int n, const VecX& g) { dU[n] = g; }, dx0,
+      dv0);
 }
 
 }  // namespace kf

@@ -1,5 +1,15 @@
 #pragma once
-// Forward simulation that keeps every state, and the adjoint pass that walks it backwards.
+// Forward simulation and the adjoint pass that walks it backwards, with optional checkpointing.
+//
+// Stored mode (checkpoint_every = 0) keeps all N+1 states. Checkpointed mode keeps every k-th state
+// (plus the system's step context there, e.g. a PCG warm start), the last state and the states a cost
+// reads; the backward pass recomputes each segment of k steps from its checkpoint into a k-state buffer.
+// Memory for states falls from (N+1) to about N/k + k + (cost steps) states, at the price of about one
+// more forward pass. Recomputed states are bit-identical to the originals (same steps, same inputs,
+// same step context), so both modes give the same gradient bit for bit.
+#include <cstddef>
+#include <algorithm>
+#include <functional>
 #include <vector>
 
 #include "core/types.h"
@@ -7,11 +17,16 @@
 
 namespace kf {
 
-// States x_0..x_N and v_0..v_N of one simulation (N steps, each 3p).
+// States of one simulation of N steps: x[n], v[n] (3p each) where kept, empty (size 0) where not.
 struct Rollout {
   std::vector<VecX> x, v;
-  int diverged_at = -1;  // first step whose result was not finite, or -1
+  std::vector<VecX> context;  // step context saved before step c*every, per checkpoint c (checkpointed)
+  int every = 0;              // checkpoint spacing in steps; 0 = every state kept
+  int diverged_at = -1;       // first step whose result was not finite, or -1
   int steps() const { return int(x.size()) - 1; }
+  bool kept(int n) const { return x[n].size() > 0; }
+  // Bytes held by the state vectors and step contexts (what checkpointing saves).
+  std::size_t stored_bytes() const;
 };
 
 // A sum of terms g_n(x_n, v_n) over steps; zero at most steps.
@@ -23,14 +38,32 @@ class StateCost {
   virtual double eval(int n, const VecX& x, const VecX& v, VecX& gx, VecX& gv) const = 0;
 };
 
-// Runs N = U.size() steps from (x0, v0) under per-step control forces U. Returns false (and sets
-// diverged_at) when a step fails; states after it are left as they were.
+// The control force of step n (3p, N). Asked for one step at a time, so controls held over a frame
+// (or absent) need no per-step storage; the returned reference stays valid until the next call.
+using StepControl = std::function<const VecX&(int n)>;
+// Receives dphi/du_n (3p) through the dynamics for each step n, in the order N-1 .. 0.
+using StepControlGradient = std::function<void(int n, const VecX& uhat)>;
+
+struct RolloutOptions {
+  int checkpoint_every = 0;             // 0: keep every state
+  const StateCost* keep_for = nullptr;  // checkpointed: also keep the states where this cost is active
+};
+
+// Runs N steps from (x0, v0) under the controls. Returns false (and sets diverged_at) when a step
+// fails; states after it are left as they were.
+bool simulate(System& sys, const VecX& x0, const VecX& v0, int N, const StepControl& u, Rollout& r,
+              const RolloutOptions& options = {});
+// The same with all N = U.size() per-step forces given, every state kept.
 bool simulate(System& sys, const VecX& x0, const VecX& v0, const std::vector<VecX>& U, Rollout& r);
 
-// Sum of the cost over the rollout's states.
+// Sum of the cost over the rollout's states (every active step must be kept).
 double cost_value(const StateCost& cost, const Rollout& r);
 
-// Adjoint pass: dU[n] = dphi/du_n through the dynamics, dx0/dv0 = dphi/dx_0, dphi/dv_0.
+// Adjoint pass over a successful rollout: dphi/du_n to `du` for n = N-1 .. 0, and dx0, dv0 =
+// dphi/dx_0, dphi/dv_0. Checkpointed rollouts are recomputed segment by segment (this runs sys.step).
+void backward(System& sys, const Rollout& r, const StepControl& u, const StateCost& cost,
+              const StepControlGradient& du, VecX& dx0, VecX& dv0);
+// The same with per-step forces U and gradients dU (resized to N).
 void backward(System& sys, const Rollout& r, const std::vector<VecX>& U, const StateCost& cost,
               std::vector<VecX>& dU, VecX& dx0, VecX& dv0);
 

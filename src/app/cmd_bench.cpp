@@ -1,12 +1,102 @@
-// keyframe bench: sweep speed against error.
+// keyframe bench: sweep speed against error (cloth), cost against size (flock), memory against steps.
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+
+#include "app/bench_sweeps.h"
 #include "app/commands.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
 
 namespace kf {
 
 void add_bench_command(CLI::App& app) {
-  auto* sub = app.add_subcommand("bench", "sweep speed against error (not available yet)");
-  sub->allow_extras();
-  sub->callback([] { throw NotReady("'bench' is not available yet in this build"); });
+  auto* sub = app.add_subcommand(
+      "bench",
+      "sweep speed against error: cloth (time step, resolution, PCG tolerance, per-step vs per-frame control), "
+      "flock (agents, fitted scaling exponent), memory (peak RSS against steps with and without adjoint "
+      "checkpointing); writes CSV + PNG under --out");
+  struct Options {
+    std::string out = "out/bench";
+    std::vector<std::string> only;
+    bool quick = false;
+    ClothSweepOptions cloth;
+    FlockSweepOptions flock;
+    MemorySweepOptions memory;
+    int point_steps = 0, point_every = 0, point_resolution = 16;
+  };
+  auto o = std::make_shared<Options>();
+  sub->add_option("--out", o->out, "output directory")->capture_default_str();
+  sub->add_flag("--quick", o->quick,
+                "reduced sweep (a few minutes): substeps 1,4,16; n 16,24,32; tolerances 1e-4,1e-6,1e-8; agents "
+                "100,300,1000; steps 500..4000; fewer samples and evaluations. Options given explicitly win.");
+  sub->add_option("--only", o->only, "run only these sweeps")
+      ->check(CLI::IsMember({"cloth", "flock", "memory"}))
+      ->delimiter(',');
+  auto* c = sub->add_option_group("cloth sweep");
+  c->add_option("--substeps", o->cloth.substeps, "steps per 1/30 s frame (h = 1/(30 x substeps))")
+      ->capture_default_str()->delimiter(',')->check(CLI::Range(1, 1000));
+  c->add_option("--resolutions", o->cloth.resolutions, "n for n x n cloths")
+      ->capture_default_str()->delimiter(',')->check(CLI::Range(2, 1024));
+  c->add_option("--tolerances", o->cloth.tolerances, "PCG relative residuals")
+      ->capture_default_str()->delimiter(',')->check(CLI::Range(1e-15, 1.0));
+  c->add_option("--cloth-resolution", o->cloth.base_resolution, "n of the sweeps that do not vary it")
+      ->capture_default_str()->check(CLI::Range(2, 1024));
+  c->add_option("--cloth-substeps", o->cloth.base_substeps, "substeps of the sweeps that do not vary it")
+      ->capture_default_str()->check(CLI::Range(1, 1000));
+  c->add_option("--cloth-frames", o->cloth.frames, "frames simulated (1/30 s each)")
+      ->capture_default_str()->check(CLI::Range(1, 100000));
+  c->add_option("--samples", o->cloth.gradcheck_samples, "finite-difference coordinates per point")
+      ->capture_default_str()->check(CLI::Range(0, 100000));
+  c->add_option("--cloth-evaluations", o->cloth.optimize_evaluations, "L-BFGS evaluations per point")
+      ->capture_default_str()->check(CLI::Range(0, 100000));
+  auto* f = sub->add_option_group("flock sweep");
+  f->add_option("--agents", o->flock.agents, "flock sizes")
+      ->capture_default_str()->delimiter(',')->check(CLI::Range(2, 1000000));
+  f->add_option("--flock-frames", o->flock.frames, "frames simulated (1/30 s, one step each)")
+      ->capture_default_str()->check(CLI::Range(1, 100000));
+  f->add_option("--flock-evaluations", o->flock.optimize_evaluations, "L-BFGS evaluations per point")
+      ->capture_default_str()->check(CLI::Range(0, 100000));
+  auto* m = sub->add_option_group("memory sweep");
+  m->add_option("--steps", o->memory.steps, "step counts (cloth, 40 steps per frame)")
+      ->capture_default_str()->delimiter(',')->check(CLI::Range(40, 10000000));
+  m->add_option("--checkpoint-every", o->memory.checkpoint_every, "checkpoint spacing of the checkpointed runs")
+      ->capture_default_str()->check(CLI::Range(1, 10000000));
+  m->add_option("--memory-resolution", o->memory.resolution, "n of the n x n cloth")
+      ->capture_default_str()->check(CLI::Range(2, 1024));
+  // The child side of the memory sweep: one gradient in a fresh process.
+  auto* hidden = sub->add_option_group("");
+  hidden->add_option("--memory-point", o->point_steps);
+  hidden->add_option("--memory-every", o->point_every);
+  sub->callback([o, sub] {
+    if (o->point_steps > 0) {
+      memory_point(o->point_steps, o->point_every, o->memory.resolution);
+      return;
+    }
+    auto given = [&](const std::string& name) { return sub->count(name) > 0; };
+    if (o->quick) {
+      if (!given("--substeps")) o->cloth.substeps = {1, 4, 16};
+      if (!given("--resolutions")) o->cloth.resolutions = {16, 24, 32};
+      if (!given("--tolerances")) o->cloth.tolerances = {1e-4, 1e-6, 1e-8};
+      if (!given("--cloth-frames")) o->cloth.frames = 10;
+      if (!given("--samples")) o->cloth.gradcheck_samples = 12;
+      if (!given("--cloth-evaluations")) o->cloth.optimize_evaluations = 15;
+      if (!given("--agents")) o->flock.agents = {100, 300, 1000};
+      if (!given("--flock-frames")) o->flock.frames = 20;
+      if (!given("--flock-evaluations")) o->flock.optimize_evaluations = 6;
+      if (!given("--steps")) o->memory.steps = {500, 1000, 2000, 4000};
+    }
+    auto want = [&](const std::string& s) {
+      return o->only.empty() || std::find(o->only.begin(), o->only.end(), s) != o->only.end();
+    };
+    const std::filesystem::path out = o->out;
+    ensure_directory(out);
+    nlohmann::json summary = {{"quick", o->quick}};
+    if (want("memory")) summary["memory"] = bench_memory(o->memory, out, std::filesystem::read_symlink("/proc/self/exe"));
+    if (want("flock")) summary["flock"] = bench_flock(o->flock, out);
+    if (want("cloth")) summary["cloth"] = bench_cloth(o->cloth, out);
+    write_file_atomic(out / "summary.json", summary.dump(2) + "\n");
+  });
 }
 
 }  // namespace kf

@@ -12,6 +12,10 @@ void add_optimize_options(CLI::App* sub, OptimizeOptions& o) {
   sub->add_option("--max-evaluations", o.max_evaluations,
                   "override the scene's optimizer.max_evaluations (each = one forward + one adjoint pass)")
       ->check(CLI::Range(0, 1000000));
+  sub->add_option("--checkpoint-every", o.checkpoint_every,
+                  "override the scene's optimizer.checkpoint_every: keep every k-th state for the adjoint pass "
+                  "and recompute the rest (0 = keep all states)")
+      ->check(CLI::Range(0, 10000000));
   sub->add_flag("--quiet", o.quiet, "no line per evaluation, only a progress display");
 }
 

@@ -114,6 +114,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     time.substeps = stages[s].substeps;
     if (s > 0) sys = make_system(scene, time.h());
     problem = std::make_unique<Problem>(scene, time, *sys);
+    if (opt.checkpoint_every >= 0) problem->set_checkpoint_every(opt.checkpoint_every);
     z = z.size() == 0 ? problem->initial_guess() : problem->controls().remap_from(z, z_time);
     if (z.size() != problem->size())
       throw InputError((dir / "controls.bin").string() + ": holds " + std::to_string(z.size()) +
@@ -160,6 +161,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
                            {"control_variables", problem->size()},
                            {"steps", time.steps()},
                            {"substeps", time.substeps},
+                           {"checkpoint_every", problem->checkpoint_every()},
                            {"stages", stages.size()},
                            {"resumed", resuming},
                            {"status", status},

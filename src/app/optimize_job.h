@@ -10,6 +10,7 @@ struct OptimizeOptions {
   int max_evaluations = -1;   // override the scene's limit (per stage) when >= 0
   bool quiet = false;         // no per-evaluation lines on stdout
   std::string resume;         // run directory to continue from (its scene.json and controls.bin)
+  int checkpoint_every = -1;  // override the scene's optimizer.checkpoint_every when >= 0
 };
 
 struct OptimizeOutcome {

@@ -8,7 +8,7 @@ namespace kf {
 namespace fs = std::filesystem;
 
 bool plot_csv(const fs::path& csv, const fs::path& png, const std::string& title, int x_col,
-              const std::vector<int>& y_cols, bool log_y) {
+              const std::vector<int>& y_cols, bool log_y, bool log_x) {
   if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
     std::cerr << "keyframe: note: gnuplot is not installed; skipped " << png.string() << "\n";
     return false;
@@ -19,6 +19,7 @@ bool plot_csv(const fs::path& csv, const fs::path& png, const std::string& title
   script += "set datafile separator ','\nset key autotitle columnhead\nset grid\n";
   script += "set title '" + title + "'\n";
   if (log_y) script += "set logscale y\nset format y '%.0e'\n";
+  if (log_x) script += "set logscale x\n";
   script += "plot ";
   for (size_t k = 0; k < y_cols.size(); ++k)
     script += (k ? ", " : "") + ("'" + csv.string() + "' using " + std::to_string(x_col) + ":" +

@@ -66,6 +66,39 @@ VecX Controls::remap_from(const VecX& z, const TimeSpec& from) const {
   return out;
 }
 
+void Controls::force_at(const VecX& z, int n, VecX& u) const {
+  const int nc = int(comps_.size()), dof = 3 * particles_, stride = particles_ * nc;
+  if (u.size() != dof) u.resize(dof);
+  u.setZero();
+  if (kind_ == "initial_velocity") return;
+  const int b = kind_ == "per_step" ? n : n / substeps_;
+  for (int i = 0; i < particles_; ++i)
+    for (int c = 0; c < nc; ++c) u[3 * i + comps_[c]] = z[b * stride + i * nc + c];
+}
+
+void Controls::add_step_gradient(int n, const VecX& uhat, VecX& dz) const {
+  if (kind_ == "initial_velocity") return;
+  const int nc = int(comps_.size()), stride = particles_ * nc;
+  const int b = kind_ == "per_step" ? n : n / substeps_;
+  for (int i = 0; i < particles_; ++i)
+    for (int c = 0; c < nc; ++c) dz[b * stride + i * nc + c] += uhat[3 * i + comps_[c]];
+}
+
+void Controls::initial_velocity(const VecX& z, VecX& v0) const {
+  const int nc = int(comps_.size());
+  v0 = v0_scene_;
+  if (kind_ != "initial_velocity") return;
+  for (int i = 0; i < particles_; ++i)
+    for (int c = 0; c < nc; ++c) v0[3 * i + comps_[c]] = z[i * nc + c];
+}
+
+void Controls::gather_initial_velocity(const VecX& dv0, VecX& dz) const {
+  const int nc = int(comps_.size());
+  if (kind_ != "initial_velocity") return;
+  for (int i = 0; i < particles_; ++i)
+    for (int c = 0; c < nc; ++c) dz[i * nc + c] += dv0[3 * i + comps_[c]];
+}
+
 double Controls::effort(const VecX& z, VecX& dz) const {
   if (kind_ == "initial_velocity") {
     const VecX d = z - initial_guess();

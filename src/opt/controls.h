@@ -26,6 +26,14 @@ class Controls {
   // Carries controls made for `from` (another substep count) over to this parameterisation: per-frame
   // and initial-velocity controls are unchanged; per-step forces are held over the nearest coarse step.
   VecX remap_from(const VecX& z, const TimeSpec& from) const;
+  // One step at a time (no per-step storage): the force of step n (3p, resized here) and the chain
+  // rule of one step's dphi/du_n (3p) added into dz (size()). Zero / nothing for initial velocities.
+  void force_at(const VecX& z, int n, VecX& u) const;
+  void add_step_gradient(int n, const VecX& uhat, VecX& dz) const;
+  // The initial velocities z gives (3p).
+  void initial_velocity(const VecX& z, VecX& v0) const;
+  // dphi/dv0 -> dphi/dz for initial-velocity control, added into dz (nothing for force controls).
+  void gather_initial_velocity(const VecX& dv0, VecX& dz) const;
   // Control effort ½α∫‖u‖²dt (forces) or ½α‖v0 − v0_scene‖² (initial velocities); adds its gradient.
   double effort(const VecX& z, VecX& dz) const;
 

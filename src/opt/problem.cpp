@@ -14,7 +14,8 @@ VecX scene_initial_velocity(System& sys) {
 
 Problem::Problem(const Scene& scene, const TimeSpec& time, System& sys)
     : time_(time), sys_(sys),
-      controls_(scene.controls, time, sys.particles(), sys.planar(), scene_initial_velocity(sys)) {
+      controls_(scene.controls, time, sys.particles(), sys.planar(), scene_initial_velocity(sys)),
+      checkpoint_every_(scene.optimizer.checkpoint_every) {
   sys_.initial_state(x0_, v0_scene_);
   terms_at_step_.resize(time_.steps() + 1);
   for (const auto& spec : scene.objectives) {
@@ -32,8 +33,16 @@ double Problem::eval(int n, const VecX& x, const VecX& v, VecX& gx, VecX& gv) co
 }
 
 double Problem::evaluate(const VecX& z, VecX* grad) {
-  controls_.expand(z, v0_, U_);
-  bool ok = simulate(sys_, x0_, v0_, U_, rollout_);
+  controls_.initial_velocity(z, v0_);
+  // Forces are made one step at a time, so per-frame controls are never expanded per step.
+  const StepControl u_at = [&](int n) -> const VecX& {
+    controls_.force_at(z, n, u_);
+    return u_;
+  };
+  RolloutOptions options;
+  options.checkpoint_every = grad ? checkpoint_every_ : 0;
+  options.keep_for = this;
+  bool ok = simulate(sys_, x0_, v0_, time_.steps(), u_at, rollout_, options);
   double phi = 0;
   breakdown_.clear();
   if (ok) {
@@ -50,8 +59,10 @@ double Problem::evaluate(const VecX& z, VecX* grad) {
     phi += e;
     ok = std::isfinite(phi);
     if (ok && grad) {
-      backward(sys_, rollout_, U_, *this, dU_, dx0_, dv0_);
-      controls_.gather(dU_, dv0_, *grad);
+      grad->setZero(size());
+      backward(sys_, rollout_, u_at, *this, [&](int n, const VecX& uhat) { controls_.add_step_gradient(n, uhat, *grad); },
+               dx0_, dv0_);
+      controls_.gather_initial_velocity(dv0_, *grad);
       *grad += dz_effort;
       ok = grad->allFinite();
     }
@@ -63,13 +74,24 @@ double Problem::evaluate(const VecX& z, VecX* grad) {
     phi_good_ = phi;
     return phi;
   }
-  // Diverged: a smooth bowl around the last good point, far above anything a good step gives.
-  const double scale = 1e6 + 1e3 * std::abs(phi_good_);
+  // Diverged: a smooth bowl around the last good point, far above anything a good step gives. Every
+  // quantity is formed so that huge trial controls (or a huge last good point) cannot overflow it.
+  const double scale = 1e6 + 1e3 * std::min(std::abs(phi_good_), 1e250);
   const VecX d = have_good_ ? VecX(z - z_good_) : VecX(z);
-  const double norm2 = 1.0 + std::max(1.0, z_good_.size() ? z_good_.squaredNorm() : 1.0);
+  const double r0 = std::hypot(1.0, std::max(1.0, z_good_.size() ? z_good_.stableNorm() : 1.0));
   breakdown_ = {{"diverged", 1.0}};
-  if (grad) *grad = (2.0 * scale / norm2) * d;
-  return scale * (1.0 + d.squaredNorm() / norm2);
+  const double t = d.allFinite() ? d.stableNorm() / r0 : INFINITY;  // distance in units of r0
+  constexpr double kT = 1e6;
+  if (t <= kT) {
+    if (grad) *grad = (2.0 * scale) * ((d / r0) / r0);
+    return scale * (1.0 + t * t);
+  }
+  // Beyond t = kT the bowl grows as log t (value and slope continuous at kT), so it never overflows.
+  if (grad) {
+    if (std::isfinite(t)) *grad = (2.0 * scale * kT * kT) * ((((d / t) / t) / r0) / r0);
+    else grad->setZero(z.size());
+  }
+  return scale * (1.0 + kT * kT * (1.0 + 2.0 * std::log(std::min(t, 1e300) / kT)));
 }
 
 }  // namespace kf

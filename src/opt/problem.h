@@ -29,9 +29,16 @@ class Problem : public StateCost {
   double evaluate(const VecX& z, VecX* grad);
   bool last_diverged() const { return diverged_; }
 
+  // Adjoint checkpointing (scene key optimizer.checkpoint_every): evaluations with a gradient keep
+  // every k-th state and recompute the others in the backward pass; 0 keeps every state. The gradient
+  // is the same bit for bit either way. Evaluations without a gradient always keep every state.
+  void set_checkpoint_every(int k) { checkpoint_every_ = k; }
+  int checkpoint_every() const { return checkpoint_every_; }
+
   // Values of each term (keyframe terms by name, then "effort") at the last evaluated point.
   const std::vector<std::pair<std::string, double>>& breakdown() const { return breakdown_; }
-  // The states of the last evaluated point (valid unless it diverged).
+  // The states of the last evaluated point (valid unless it diverged; with checkpointing and a
+  // gradient only the kept ones, see Rollout::kept).
   const Rollout& rollout() const { return rollout_; }
 
   // StateCost: keyframe terms at the steps of their frames.
@@ -45,7 +52,8 @@ class Problem : public StateCost {
   std::vector<std::unique_ptr<ObjectiveTerm>> terms_;
   std::vector<std::vector<int>> terms_at_step_;  // term indices per step
   VecX x0_, v0_scene_, v0_;
-  std::vector<VecX> U_, dU_;
+  VecX u_;  // control force of the step being simulated
+  int checkpoint_every_ = 0;
   VecX dx0_, dv0_;
   Rollout rollout_;
   bool diverged_ = false;

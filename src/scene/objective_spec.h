@@ -39,6 +39,7 @@ struct OptimizerSpec {
   double max_seconds = 0;  // 0: no limit
   int memory = 10;         // L-BFGS vectors
   std::vector<StageSpec> schedule;  // empty: one stage at the scene's substeps
+  int checkpoint_every = 0;  // adjoint pass keeps every k-th state and recomputes the rest; 0: keep all
 };
 
 }  // namespace kf

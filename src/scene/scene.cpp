@@ -81,6 +81,7 @@ OptimizerSpec parse_optimizer(Block b) {
     stage.finish();
     o.schedule.push_back(st);
   }
+  o.checkpoint_every = b.integer("checkpoint_every", o.checkpoint_every, 0, 10'000'000);
   b.finish();
   return o;
 }

@@ -39,6 +39,13 @@ class System {
   virtual void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const VecX& xhat1,
                             const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) = 0;
 
+  // Solver state besides (x, v) that step n depends on (e.g. a PCG warm start carried over from step
+  // n-1), so that a step recomputed from a checkpoint repeats the original bit for bit. Saved just
+  // before step n runs; empty when there is none. Restoring it makes the next step(n, ...) behave as it
+  // did in the original sequence.
+  virtual void save_step_context(int /*n*/, VecX& context) const { context.resize(0); }
+  virtual void restore_step_context(int /*n*/, const VecX& /*context*/) {}
+
   // One-line description for logs ("flock: 200 agents, grid neighbour search").
   virtual std::string describe() const = 0;
 

@@ -239,6 +239,20 @@ void ClothSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& 
   uhat = h * w;
 }
 
+void ClothSystem::save_step_context(int n, VecX& context) const {
+  if (last_forward_n_ == n - 1) context = dv_;
+  else context.resize(0);
+}
+
+void ClothSystem::restore_step_context(int n, const VecX& context) {
+  if (context.size() == dv_.size()) {
+    dv_ = context;
+    last_forward_n_ = n - 1;
+  } else {
+    last_forward_n_ = -2;
+  }
+}
+
 std::string ClothSystem::describe() const {
   std::ostringstream os;
   os << "cloth: " << spec_.nx << "x" << spec_.ny << " particles, " << springs_.size() << " springs, "

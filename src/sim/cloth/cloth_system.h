@@ -42,6 +42,9 @@ class ClothSystem final : public System {
   void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const VecX& xhat1, const VecX& vhat1,
                     VecX& xhat, VecX& vhat, VecX& uhat) override;
   std::string describe() const override;
+  // The PCG warm start of step n (the solution of step n-1 when that was the last forward solve).
+  void save_step_context(int n, VecX& context) const override;
+  void restore_step_context(int n, const VecX& context) override;
 
   // Evaluates forces f and the blocks of K, D and A at (x, v) of step n (the forward pass does this).
   void assemble(int n, const VecX& x, const VecX& v);

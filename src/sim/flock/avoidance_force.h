@@ -2,7 +2,7 @@
 // Collision avoidance: agents closer than `radius` push each other apart.
 //
 // Pair force on i from j, with d = x_i - x_j, r = |d|:
-//   f = k w(r) d / sqrt(r^2 + eps^2),   w = (1 - r^2/R^2)^2,   eps = 0.3 R.
+//   f = k w(r) d / sqrt(r^2 + eps^2),   w = (1 - r^2/R^2)^3,   eps = 0.3 R.
 // Far from contact it is a push of k w along the unit direction; the softened direction keeps it
 // finite (and zero) when two agents coincide, and its stiffness bounded (k / eps) for the explicit step.
 // Position-only, so D = 0; the pair Jacobian is symmetric and K^T = K.

@@ -3,20 +3,18 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sim/flock/smooth_kernel.h"
+
 namespace kf {
 
 namespace {
 constexpr double kAvoidanceSoftening = 0.3;  // eps / R, as in avoidance_force.cpp
 
-// w = (1 - r2/R^2)^2 and dw/d(r2) for r2 < R^2, else zeros.
+// The shared kernel (smooth_kernel.h) in the fused loop's calling convention.
 inline void kernel(double r2, double inv_R2, double& w, double& dw) {
-  const double t = 1.0 - r2 * inv_R2;
-  if (t <= 0) {
-    w = dw = 0;
-    return;
-  }
-  w = t * t;
-  dw = -2.0 * t * inv_R2;
+  const KernelWeight k = smooth_kernel(r2, 1.0 / std::sqrt(inv_R2));
+  w = k.w;
+  dw = k.dw_dr2;
 }
 }  // namespace
 

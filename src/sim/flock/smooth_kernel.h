@@ -1,6 +1,7 @@
 #pragma once
-// The C1 weight shared by the neighbour forces: w(r) = (1 - r^2/R^2)^2 for r < R, else 0.
-// Value and slope both vanish at r = R, so forces and their Jacobians are continuous at the cut-off.
+// The C2 weight shared by the neighbour forces: w(r) = (1 - r^2/R^2)^3 for r < R, else 0.
+// Value, slope and curvature vanish at r = R, so forces and their Jacobians are continuous at the
+// cut-off and the Jacobians have no kink there either (finite-difference checks stay at round-off).
 
 namespace kf {
 
@@ -14,7 +15,7 @@ inline KernelWeight smooth_kernel(double r2, double radius) {
   const double inv_r2 = 1.0 / (radius * radius);
   const double t = 1.0 - r2 * inv_r2;
   if (t <= 0) return {};
-  return {t * t, -2.0 * t * inv_r2};
+  return {t * t * t, -3.0 * t * t * inv_r2};
 }
 
 }  // namespace kf

@@ -1,0 +1,44 @@
+#pragma once
+// The sweeps of `keyframe bench`: each writes <out>/<name>.csv and .png and returns a short summary.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace kf {
+
+struct ClothSweepOptions {
+  std::vector<int> substeps{1, 2, 4, 8, 16, 32};   // steps per 1/30 s frame: h = 1/30 .. 1/960 s
+  std::vector<int> resolutions{16, 32, 64, 128};   // n for an n x n cloth
+  std::vector<double> tolerances{1e-3, 1e-4, 1e-6, 1e-8, 1e-10};  // PCG relative residual
+  int base_resolution = 16, base_substeps = 4, frames = 15;
+  int gradcheck_samples = 24, optimize_evaluations = 30;
+};
+
+struct FlockSweepOptions {
+  std::vector<int> agents{100, 300, 1000, 3000, 10000};
+  int frames = 30, optimize_evaluations = 10;
+};
+
+struct MemorySweepOptions {
+  std::vector<int> steps{500, 1000, 2000, 4000, 8000};
+  int checkpoint_every = 50, resolution = 16;
+};
+
+// Cloth: time step, resolution, PCG tolerance, per-step vs per-frame control.
+nlohmann::json bench_cloth(const ClothSweepOptions& o, const std::filesystem::path& out);
+// Flock: agents against time per gradient and per short optimisation, with fitted exponents.
+nlohmann::json bench_flock(const FlockSweepOptions& o, const std::filesystem::path& out);
+// Peak resident memory of one cloth gradient against steps, with and without checkpointing; each
+// point runs in a fresh `keyframe` process (`self` is this executable).
+nlohmann::json bench_memory(const MemorySweepOptions& o, const std::filesystem::path& out,
+                            const std::filesystem::path& self);
+// The child side: one gradient of an n x n cloth over `steps` steps, printed as one JSON line with the
+// peak resident memory (VmHWM, kB) before and after.
+void memory_point(int steps, int checkpoint_every, int resolution);
+
+// Least-squares slope of log(y) against log(x).
+double fitted_exponent(const std::vector<double>& x, const std::vector<double>& y);
+
+}  // namespace kf
