@@ -18,13 +18,13 @@ void add_gradcheck_command(CLI::App& app) {
   struct Options {
     std::string scene;
     int samples = 40, frames = 0, substeps = 0;
-    double eps = 1e-5, dt = 0, perturb = 0.1;
+    double eps = 1e-2, dt = 0, perturb = 0.1;
     unsigned seed = 7;
   };
   auto o = std::make_shared<Options>();
   sub->add_option("SCENE", o->scene, "scene file (JSON)")->required();
   sub->add_option("--samples", o->samples, "coordinates to compare")->check(CLI::Range(1, 100000));
-  sub->add_option("--eps", o->eps, "finite-difference step (relative)")->check(CLI::Range(1e-12, 1.0));
+  sub->add_option("--eps", o->eps, "finite-difference step (relative; Richardson-extrapolated from it and its half)")->check(CLI::Range(1e-12, 1.0));
   sub->add_option("--frames", o->frames, "shorten the scene to this many frames (keyframes move proportionally)")
       ->check(CLI::Range(1, 1000000));
   sub->add_option("--substeps", o->substeps, "override the integrator steps per frame")->check(CLI::Range(1, 100000));

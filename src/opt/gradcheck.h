@@ -19,7 +19,8 @@ struct GradcheckResult {
 };
 
 // Checks at z (size problem.size()) `samples` coordinates chosen with `seed`, preferring coordinates whose
-// adjoint gradient is not negligible so the check cannot pass on zeros. eps is relative to max(1, |z_i|).
+// adjoint gradient is not negligible so the check cannot pass on zeros. eps (the larger of the two
+// Richardson steps) is relative to max(1, |z_i|); 1e-2 suits φ of any size for smooth systems.
 GradcheckResult gradcheck(Problem& problem, const VecX& z, int samples, double eps, unsigned seed);
 
 }  // namespace kf

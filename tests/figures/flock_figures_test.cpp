@@ -120,7 +120,7 @@ TEST(FlockFigures, RaceReduced) {
       {"type": "center_of_mass", "frame": 20, "weight": 10, "target": [0, 0, 2.5]},
       {"type": "center_of_mass", "frame": 40, "weight": 10, "target": [0, 0, 5]},
       {"type": "position", "frame": 40, "weight": 10, "particles": [)" + std::to_string(runner) +
-                                      R"(], "targets": [[0, 0, 9]]}]})",
+                                      R"(], "targets": [[0, 0, 10.5]]}]})",
                                   "race.json");
   const Optimised o = optimise(scene);
   const auto& race = o.measures[2];
@@ -145,7 +145,7 @@ GradcheckResult check_gradient(const Scene& scene, double perturb, int samples) 
   std::mt19937_64 rng(11);
   std::normal_distribution<double> normal(0.0, perturb);
   for (int i = 0; i < z.size(); ++i) z[i] += normal(rng);
-  return gradcheck(problem, z, samples, 1e-5, 5);
+  return gradcheck(problem, z, samples, 0.1, 5);
 }
 
 class FigureSceneGradient : public ::testing::TestWithParam<std::string> {};
@@ -155,11 +155,11 @@ TEST_P(FigureSceneGradient, AdjointMatchesFiniteDifferences) {
   const GradcheckResult r = check_gradient(scene, 0.5, 24);
   ASSERT_GT(r.grad_norm, 1e-6) << "the gradient is zero: nothing checked";
   EXPECT_GE(r.checked, 10);
-  // Direction and size agree to round-off; single small components (near the 1e-3 floor) carry the
-  // finite-difference truncation error of the C1 force kernels and shape term, up to ~3e-4 here.
-  EXPECT_GT(r.cosine, 1 - 1e-9) << r.to_json().dump();
-  EXPECT_LT(r.rel_error_norm, 1e-4) << r.to_json().dump();
-  EXPECT_LE(r.max_rel_error, 1e-3) << r.to_json().dump();
+  // The flock adjoint is exact: agreement is limited only by the finite differences, which on these large
+  // objectives (φ ~ 1e3..1e4 at the shortened keyframes) need the Richardson step of gradcheck.
+  EXPECT_GT(r.cosine, 1 - 1e-12) << r.to_json().dump();
+  EXPECT_LT(r.rel_error_norm, 1e-7) << r.to_json().dump();
+  EXPECT_LE(r.max_rel_error, 1e-6) << r.to_json().dump();
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, FigureSceneGradient,
@@ -185,7 +185,7 @@ TEST(FlockFigures, GradientOfTwentyAgentsOverSixtySteps) {
   ASSERT_EQ(scene.time.steps(), 60);
   const GradcheckResult r = check_gradient(scene, 0.5, 40);
   ASSERT_GT(r.grad_norm, 1e-6);
-  EXPECT_LE(r.max_rel_error, 1e-5) << r.to_json().dump();
+  EXPECT_LE(r.max_rel_error, 1e-6) << r.to_json().dump();
   EXPECT_GT(r.cosine, 1 - 1e-10);
 }
 

@@ -50,11 +50,11 @@ void expect_file_valid(const fs::path& file) {
     EXPECT_NO_THROW({ auto t = load_trajectory(file); (void)t; });
   } else if (name == "controls.bin") {
     const std::string b = read_text(file);
-    ASSERT_GE(b.size(), 16u);
+    ASSERT_GE(b.size(), 20u);
     EXPECT_EQ(b.substr(0, 8), "KFCTRL01");
     uint64_t n = 0;
     std::memcpy(&n, b.data() + 8, 8);
-    EXPECT_EQ(b.size(), 16 + 8 * n);
+    EXPECT_EQ(b.size(), 20 + 8 * n);  // header: magic, count, substeps (opt/controls_file.h)
   } else if (ext == ".png") {
     EXPECT_NO_THROW({ auto img = render::read_png(file); (void)img; });
   } else if (ext == ".csv") {

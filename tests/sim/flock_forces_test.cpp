@@ -1,6 +1,8 @@
 // Every flock force: value, d/dx and d/dv against central finite differences.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <functional>
 #include <random>
 
@@ -25,14 +27,20 @@ double max_relative_error(const VecX& analytic, const VecX& fd) {
 }
 
 // Columns of d f / d d by central differences.
-Mat3 fd_jacobian(const std::function<Vec3(const Vec3&)>& f, const Vec3& d) {
+// Central differences; `step` shrinks near a kernel cut-off, where the force varies on the scale of the
+// distance to it (the C2 kernel's third derivative grows like 1 / (R - |d|)).
+Mat3 fd_jacobian(const std::function<Vec3(const Vec3&)>& f, const Vec3& d, double step = kEps) {
   Mat3 J;
   for (int c = 0; c < 3; ++c) {
     Vec3 e = Vec3::Zero();
-    e[c] = kEps;
-    J.col(c) = (f(d + e) - f(d - e)) / (2 * kEps);
+    e[c] = step;
+    J.col(c) = (f(d + e) - f(d - e)) / (2 * step);
   }
   return J;
+}
+
+double fd_step(const Vec3& d, double radius) {
+  return std::clamp(1e-3 * std::abs(radius - d.norm()), 1e-10, kEps);
 }
 
 double mat_relative_error(const Mat3& a, const Mat3& fd) {
@@ -82,7 +90,7 @@ TEST(AvoidanceForce, RepulsiveFiniteAndZeroBeyondRadius) {
   EXPECT_GT(f.dot(d), 0.0);
   EXPECT_NEAR(f.x() * d.z() - f.z() * d.x(), 0.0, 1e-15);  // parallel to d
   // Magnitude approaches k w far from contact.
-  const double r = 1.2, w = std::pow(1 - r * r / 2.25, 2);
+  const double r = 1.2, w = std::pow(1 - r * r / 2.25, 3);
   EXPECT_NEAR(avoidance_pair_force(p, Vec3(r, 0, 0)).norm(), 6.0 * w * r / std::hypot(r, 0.45), 1e-12);
 }
 
@@ -94,7 +102,7 @@ TEST(AvoidanceForce, JacobianMatchesFiniteDifferences) {
     const Mat3 J = avoidance_pair_jacobian(p, d);
     ASSERT_GT(J.norm(), 0.0) << d.transpose();
     ASSERT_TRUE(J.isApprox(J.transpose(), 1e-14));
-    const Mat3 fd = fd_jacobian([&](const Vec3& e) { return avoidance_pair_force(p, e); }, d);
+    const Mat3 fd = fd_jacobian([&](const Vec3& e) { return avoidance_pair_force(p, e); }, d, fd_step(d, p.radius));
     worst = std::max(worst, mat_relative_error(J, fd));
     EXPECT_LT(mat_relative_error(J, fd), 1e-6) << "d = " << d.transpose() << "\nJ =\n" << J << "\nfd =\n" << fd;
   }
@@ -107,10 +115,10 @@ TEST(MatchingForce, PairValueAndJacobiansMatchFiniteDifferences) {
   std::uniform_real_distribution<double> u(-1, 1);
   for (const Vec3& d : separations(p.radius, rng)) {
     const Vec3 dv(u(rng), 0, u(rng));
-    const double w = std::pow(1 - d.squaredNorm() / 9.0, 2);
+    const double w = std::pow(1 - d.squaredNorm() / 9.0, 3);
     EXPECT_NEAR((matching_pair_force(p, d, dv) - 0.5 * w * dv).norm(), 0.0, 1e-15);
     const Mat3 Jx = matching_pair_dx(p, d, dv);
-    const Mat3 fdx = fd_jacobian([&](const Vec3& e) { return matching_pair_force(p, e, dv); }, d);
+    const Mat3 fdx = fd_jacobian([&](const Vec3& e) { return matching_pair_force(p, e, dv); }, d, fd_step(d, p.radius));
     if (d.norm() > 1e-6) {
       ASSERT_GT(Jx.norm(), 0.0) << d.transpose();
       EXPECT_LT(mat_relative_error(Jx, fdx), 1e-6) << "d = " << d.transpose();
