@@ -16,7 +16,8 @@ bool plot_csv(const fs::path& csv, const fs::path& png, const std::string& title
   const fs::path tmp = png.parent_path() / ("." + png.filename().string() + ".tmp.png");
   std::string script = "set terminal pngcairo size 900,540 font 'DejaVu Sans,11'\n";
   script += "set output '" + tmp.string() + "'\n";
-  script += "set datafile separator ','\nset key autotitle columnhead\nset grid\n";
+  // Plain text labels: column names such as grad_norm must not turn into subscripts.
+  script += "set termoption noenhanced\nset datafile separator ','\nset key autotitle columnhead\nset grid\n";
   script += "set title '" + title + "'\n";
   if (log_y) script += "set logscale y\nset format y '%.0e'\n";
   if (log_x) script += "set logscale x\n";
