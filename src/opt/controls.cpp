@@ -1,18 +1,54 @@
 #include "opt/controls.h"
 
+#include <algorithm>
+
+#include <Eigen/Geometry>  // cross products
+
 namespace kf {
 
-Controls::Controls(const ControlSpec& spec, const TimeSpec& time, int particles, bool planar, const VecX& v0_scene)
-    : kind_(spec.kind), alpha_(spec.alpha), steps_(time.steps()), substeps_(time.substeps), frames_(time.frames),
+Controls::Controls(const ControlSpec& spec, const TimeSpec& time, int particles, bool planar, const VecX& x0_scene,
+                   const VecX& v0_scene)
+    : name_(spec.kind), kind_(spec.kind), alpha_(spec.alpha), steps_(time.steps()), substeps_(time.substeps), frames_(time.frames),
       particles_(particles),
       h_(time.h()), v0_scene_(v0_scene) {
   comps_ = planar ? std::vector<int>{0, 2} : std::vector<int>{0, 1, 2};
   blocks_ = kind_ == "per_step" ? steps_ : kind_ == "per_frame" ? time.frames : 1;
+  if (kind_ == "initial_rigid_velocity") {
+    rigid_ = true;
+    kind_ = "initial_velocity";  // everywhere else it behaves as initial-velocity control
+    Vec3 c = Vec3::Zero();
+    for (int i = 0; i < particles_; ++i) c += x0_scene.segment<3>(3 * i);
+    c /= std::max(1, particles_);
+    arms_.resize(3 * particles_);
+    for (int i = 0; i < particles_; ++i) arms_.segment<3>(3 * i) = x0_scene.segment<3>(3 * i) - c;
+  }
+}
+
+void Controls::rigid_velocity(const VecX& z, VecX& v0) const {
+  const Vec3 dv = z.head<3>(), w = z.tail<3>();
+  v0 = v0_scene_;
+  for (int i = 0; i < particles_; ++i) {
+    Vec3 vi = dv + w.cross(Vec3(arms_.segment<3>(3 * i)));
+    for (int c : comps_) v0[3 * i + c] += vi[c];
+  }
+}
+
+// d(ω × r)/dω applied transposed: Σ r × g.
+void Controls::rigid_gather(const VecX& dv0, VecX& dz) const {
+  Vec3 gv = Vec3::Zero(), gw = Vec3::Zero();
+  for (int i = 0; i < particles_; ++i) {
+    Vec3 g = Vec3::Zero();
+    for (int c : comps_) g[c] = dv0[3 * i + c];
+    gv += g;
+    gw += Vec3(arms_.segment<3>(3 * i)).cross(g);
+  }
+  dz.head<3>() += gv;
+  dz.tail<3>() += gw;
 }
 
 VecX Controls::initial_guess() const {
   VecX z = VecX::Zero(size());
-  if (kind_ == "initial_velocity") {
+  if (kind_ == "initial_velocity" && !rigid_) {
     const int nc = int(comps_.size());
     for (int i = 0; i < particles_; ++i)
       for (int c = 0; c < nc; ++c) z[i * nc + c] = v0_scene_[3 * i + comps_[c]];
@@ -28,6 +64,7 @@ void Controls::expand(const VecX& z, VecX& v0, std::vector<VecX>& U) const {
     u.setZero();
   }
   v0 = v0_scene_;
+  if (rigid_) return rigid_velocity(z, v0);
   if (kind_ == "initial_velocity") {
     for (int i = 0; i < particles_; ++i)
       for (int c = 0; c < nc; ++c) v0[3 * i + comps_[c]] = z[i * nc + c];
@@ -43,6 +80,7 @@ void Controls::expand(const VecX& z, VecX& v0, std::vector<VecX>& U) const {
 void Controls::gather(const std::vector<VecX>& dU, const VecX& dv0, VecX& dz) const {
   const int nc = int(comps_.size()), stride = particles_ * nc;
   dz.setZero(size());
+  if (rigid_) return rigid_gather(dv0, dz);
   if (kind_ == "initial_velocity") {
     for (int i = 0; i < particles_; ++i)
       for (int c = 0; c < nc; ++c) dz[i * nc + c] = dv0[3 * i + comps_[c]];
@@ -88,6 +126,7 @@ void Controls::initial_velocity(const VecX& z, VecX& v0) const {
   const int nc = int(comps_.size());
   v0 = v0_scene_;
   if (kind_ != "initial_velocity") return;
+  if (rigid_) return rigid_velocity(z, v0);
   for (int i = 0; i < particles_; ++i)
     for (int c = 0; c < nc; ++c) v0[3 * i + comps_[c]] = z[i * nc + c];
 }
@@ -95,6 +134,7 @@ void Controls::initial_velocity(const VecX& z, VecX& v0) const {
 void Controls::gather_initial_velocity(const VecX& dv0, VecX& dz) const {
   const int nc = int(comps_.size());
   if (kind_ != "initial_velocity") return;
+  if (rigid_) return rigid_gather(dv0, dz);
   for (int i = 0; i < particles_; ++i)
     for (int c = 0; c < nc; ++c) dz[i * nc + c] += dv0[3 * i + comps_[c]];
 }

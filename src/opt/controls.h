@@ -1,6 +1,7 @@
 #pragma once
 // How the optimisation variables z become control forces: one force per particle per step (paper),
-// one per particle per frame held over its substeps (Stuyck ch. 8), or the initial velocities only.
+// one per particle per frame held over its substeps (Stuyck ch. 8), the initial velocities only, or one
+// initial linear and angular velocity for the whole body (a thrown sheet needs six numbers, not 3p).
 // Ground-bound (planar) systems get no y components.
 #include <vector>
 
@@ -12,11 +13,12 @@ namespace kf {
 
 class Controls {
  public:
-  // dof = 3p; v0_scene: the scene's initial velocities (the reference for initial-velocity control).
-  Controls(const ControlSpec& spec, const TimeSpec& time, int particles, bool planar, const VecX& v0_scene);
+  // dof = 3p; x0_scene, v0_scene: the scene's initial state (the reference for initial-velocity control).
+  Controls(const ControlSpec& spec, const TimeSpec& time, int particles, bool planar, const VecX& x0_scene,
+           const VecX& v0_scene);
 
-  int size() const { return blocks_ * particles_ * int(comps_.size()); }
-  const std::string& kind() const { return kind_; }
+  int size() const { return rigid_ ? 6 : blocks_ * particles_ * int(comps_.size()); }
+  const std::string& kind() const { return name_; }
   // The starting point of the optimisation: no force, or the scene's initial velocities.
   VecX initial_guess() const;
   // z (size()) -> initial velocities v0 (3p) and per-step forces U (N entries of 3p, resized here).
@@ -34,16 +36,22 @@ class Controls {
   void initial_velocity(const VecX& z, VecX& v0) const;
   // dphi/dv0 -> dphi/dz for initial-velocity control, added into dz (nothing for force controls).
   void gather_initial_velocity(const VecX& dv0, VecX& dz) const;
-  // Control effort ½α∫‖u‖²dt (forces) or ½α‖v0 − v0_scene‖² (initial velocities); adds its gradient.
+  // Control effort ½α∫‖u‖²dt (forces), ½α‖v0 − v0_scene‖² (initial velocities) or ½α‖(Δv, ω)‖² (rigid);
+  // adds its gradient.
   double effort(const VecX& z, VecX& dz) const;
 
  private:
-  std::string kind_;
+  std::string name_, kind_;  // the scene's name; how it behaves (rigid is a kind of initial_velocity)
   double alpha_;
   int steps_, substeps_, frames_, particles_, blocks_;
   double h_;
   std::vector<int> comps_;  // which of x, y, z are controlled
   VecX v0_scene_;
+  // Rigid initial velocity: z = (Δv, ω), v0_i = v0_scene_i + Δv + ω × (x0_i − c); arms_ holds x0_i − c.
+  bool rigid_ = false;
+  VecX arms_;
+  void rigid_velocity(const VecX& z, VecX& v0) const;
+  void rigid_gather(const VecX& dv0, VecX& dz) const;
 };
 
 }  // namespace kf

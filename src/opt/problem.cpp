@@ -5,6 +5,11 @@
 namespace kf {
 
 namespace {
+VecX scene_initial_position(System& sys) {
+  VecX x, v;
+  sys.initial_state(x, v);
+  return x;
+}
 VecX scene_initial_velocity(System& sys) {
   VecX x, v;
   sys.initial_state(x, v);
@@ -14,7 +19,8 @@ VecX scene_initial_velocity(System& sys) {
 
 Problem::Problem(const Scene& scene, const TimeSpec& time, System& sys)
     : time_(time), sys_(sys),
-      controls_(scene.controls, time, sys.particles(), sys.planar(), scene_initial_velocity(sys)),
+      controls_(scene.controls, time, sys.particles(), sys.planar(), scene_initial_position(sys),
+                scene_initial_velocity(sys)),
       checkpoint_every_(scene.optimizer.checkpoint_every) {
   sys_.initial_state(x0_, v0_scene_);
   terms_at_step_.resize(time_.steps() + 1);

@@ -23,7 +23,7 @@ struct ObjectiveSpec {
 };
 
 struct ControlSpec {
-  std::string kind = "per_step";  // "per_step" | "per_frame" | "initial_velocity"
+  std::string kind = "per_step";  // "per_step" | "per_frame" | "initial_velocity" | "initial_rigid_velocity"
   double alpha = 1e-4;            // weight of the control effort ½α‖u‖²
 };
 

@@ -62,7 +62,7 @@ ObjectiveSpec parse_objective(Block b, const Scene& s) {
 
 ControlSpec parse_controls(Block b, const Scene& s) {
   ControlSpec c;
-  c.kind = b.string("kind", c.kind, {"per_step", "per_frame", "initial_velocity"});
+  c.kind = b.string("kind", c.kind, {"per_step", "per_frame", "initial_velocity", "initial_rigid_velocity"});
   c.alpha = b.number("alpha", c.alpha, 0.0, 1e6);
   b.finish();
   return c;

@@ -35,19 +35,20 @@ TEST_P(ProblemGradient, AdjointMatchesFiniteDifferences) {
   VecX z = problem.initial_guess() + 0.3 * VecX::Random(problem.size());
   const GradcheckResult r = gradcheck(problem, z, 60, 1e-3, 3);
   ASSERT_GT(r.grad_norm, 1e-3);  // not trivially zero
-  EXPECT_GT(r.checked, 10);
+  EXPECT_GE(r.checked, std::min(11, problem.size()));  // the rigid throw has only six
   EXPECT_LT(r.max_rel_error, 1e-6) << "cosine " << r.cosine;
   EXPECT_GT(r.cosine, 1 - 1e-10);
 }
 
 INSTANTIATE_TEST_SUITE_P(Controls, ProblemGradient,
                          ::testing::Values(std::make_tuple("per_step", 1), std::make_tuple("per_step", 3),
-                                           std::make_tuple("per_frame", 3), std::make_tuple("initial_velocity", 2)));
+                                           std::make_tuple("per_frame", 3), std::make_tuple("initial_velocity", 2),
+                                           std::make_tuple("initial_rigid_velocity", 2)));
 
 TEST(Problem, PerFrameForcesAreHeldOverSubsteps) {
   Scene scene = toy_scene("per_frame", 4);
   test::ToySystem sys(4, scene.time.h());
-  Controls c(scene.controls, scene.time, 4, false, VecX::Zero(12));
+  Controls c(scene.controls, scene.time, 4, false, VecX::Zero(12), VecX::Zero(12));
   EXPECT_EQ(c.size(), 12 * 12);
   VecX z = VecX::LinSpaced(c.size(), 0, 1), v0;
   std::vector<VecX> U;
@@ -60,7 +61,7 @@ TEST(Problem, PerFrameForcesAreHeldOverSubsteps) {
 TEST(Problem, PlanarControlsHaveNoVerticalComponent) {
   TimeSpec t;
   t.frames = 3;
-  Controls c(ControlSpec{}, t, 5, true, VecX::Zero(15));
+  Controls c(ControlSpec{}, t, 5, true, VecX::Zero(15), VecX::Zero(15));
   EXPECT_EQ(c.size(), 3 * 5 * 2);
   VecX v0;
   std::vector<VecX> U;

@@ -47,7 +47,7 @@ std::vector<Case> cases() {
       {"target_count", replace(g, R"("particles": [0], "targets": [[0, 1, 0]])", R"("particles": [0, 1, 2], "targets": [[0, 1, 0], [1, 1, 1]])"), "/objectives/0/targets: expected 1 target or one per particle (3), got 2"},
       {"missing_targets", replace(g, R"(, "targets": [[0, 1, 0]])", ""), "/objectives/0/targets: required key is missing"},
       {"shape_on_cloth", replace(g, R"("type": "position")", R"("type": "shape", "polygon": [[0,0],[1,0],[1,1]])"), "/objectives/0/type: \"shape\" keyframes are for flocks"},
-      {"controls_kind", replace(g, R"("kind": "per_frame")", R"("kind": "per_second")"), "/controls/kind: expected one of \"per_step\", \"per_frame\", \"initial_velocity\", got \"per_second\""},
+      {"controls_kind", replace(g, R"("kind": "per_frame")", R"("kind": "per_second")"), "/controls/kind: expected one of \"per_step\", \"per_frame\", \"initial_velocity\", \"initial_rigid_velocity\", got \"per_second\""},
       {"alpha_negative", replace(g, R"("alpha": 0.001)", R"("alpha": -1)"), "/controls/alpha: expected a number in [0, 1e+06], got -1"},
       {"objectives_not_array", replace(g, R"("objectives": [)", R"("objectives": {"a": [)") , "not valid JSON"},
       {"objective_not_object", replace(g, R"([{"type": "position", "frame": 10, "particles": [0], "targets": [[0, 1, 0]]}])", "[3]"), "/objectives/0: expected an object, got number 3"},
