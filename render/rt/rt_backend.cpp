@@ -24,11 +24,33 @@ uint32_t pcg_hash(uint32_t v) {
   return (word >> 22u) ^ word;
 }
 
+// A random direction in the plane as (cos, sin) from a table: the sin/cos calls of two samples per
+// ray were an eighth of the frame time, and 4,096 angles are finer than any noise they make.
+struct UnitCircle {
+  static constexpr int kBits = 12;
+  std::array<float, 2 << kBits> cs;
+  UnitCircle() {
+    for (int i = 0; i < (1 << kBits); ++i) {
+      const double a = 2 * M_PI * (i + 0.5) / (1 << kBits);
+      cs[2 * i] = float(std::cos(a));
+      cs[2 * i + 1] = float(std::sin(a));
+    }
+  }
+};
+const UnitCircle kCircle;
+
 struct Rng {
   uint32_t s;
   float next() {
     s = pcg_hash(s);
     return float(s >> 8) * (1.0f / 16777216.0f);
+  }
+  // A uniformly random angle's cosine and sine.
+  void angle(float& c, float& sn) {
+    s = pcg_hash(s);
+    const uint32_t i = s >> (32 - UnitCircle::kBits);
+    c = kCircle.cs[2 * i];
+    sn = kCircle.cs[2 * i + 1];
   }
 };
 
@@ -45,9 +67,12 @@ inline V3 normalize(V3 a) { return a * (1.0f / std::sqrt(std::max(dot(a, a), 1e-
 inline V3 from(const Vec3& v) { return {float(v.x()), float(v.y()), float(v.z())}; }
 inline V3 from(const float* f) { return {f[0], f[1], f[2]}; }
 
+// A tangent frame around the unit vector n without square roots or branches on the hot path
+// (Duff et al., "Building an orthonormal basis, revisited", 2017).
 void orthonormal(V3 n, V3& t, V3& b) {
-  t = normalize(std::abs(n.x) < 0.9f ? cross(n, V3{1, 0, 0}) : cross(n, V3{0, 0, 1}));
-  b = cross(n, t);
+  const float sign = std::copysign(1.0f, n.z), a = -1.0f / (sign + n.z), c = n.x * n.y * a;
+  t = {1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x};
+  b = {c, sign + n.y * n.y * a, -n.y};
 }
 
 // One triangle mesh in the Embree scene, rebuilt when its size changes and refitted otherwise.
@@ -123,7 +148,7 @@ class RtBackend final : public Backend {
     sh.forward = from(fw);
     sh.right = from(rt) * (tan_half * float(camera.aspect));
     sh.up = from(up) * tan_half;
-    sh.sun = from(look.light_direction);
+    sh.sun = normalize(from(look.light_direction));
     orthonormal(sh.sun, sh.sun_t, sh.sun_b);
     sh.sun_radius = float(std::tan(0.5 * look.light_angle * M_PI / 180.0));
     sh.ambient = float(look.ambient);
@@ -220,8 +245,10 @@ class RtBackend final : public Backend {
         const V3 p = sh.eye + dir * rh.ray.tfar[l] + ng * sh.eps;
         // Sun: a point on a disc of directions around the light direction.
         {
-          const float r = sh.sun_radius * std::sqrt(rng[l].next()), phi = 6.2831853f * rng[l].next();
-          const V3 d = normalize(sh.sun + sh.sun_t * (r * std::cos(phi)) + sh.sun_b * (r * std::sin(phi)));
+          const float r = sh.sun_radius * std::sqrt(rng[l].next());
+          float c, sn;
+          rng[l].angle(c, sn);
+          const V3 d = normalize(sh.sun + sh.sun_t * (r * c) + sh.sun_b * (r * sn));
           ndl[l] = dot(n, d);
           if (ndl[l] > 0.0f) {
             sun_valid[l] = -1;
@@ -232,9 +259,10 @@ class RtBackend final : public Backend {
         {
           V3 t, bt;
           orthonormal(n, t, bt);
-          const float r1 = rng[l].next(), r2 = rng[l].next();
-          const float rr = std::sqrt(r1), phi = 6.2831853f * r2;
-          const V3 d = normalize(t * (rr * std::cos(phi)) + bt * (rr * std::sin(phi)) + n * std::sqrt(1.0f - r1));
+          const float r1 = rng[l].next(), rr = std::sqrt(r1);
+          float c, sn;
+          rng[l].angle(c, sn);
+          const V3 d = t * (rr * c) + bt * (rr * sn) + n * std::sqrt(1.0f - r1);  // unit: t, bt, n are
           sky_weight[l] = 0.75f + 0.25f * n.y;
           if (dot(d, ng) > 0.0f) {
             sky_valid[l] = -1;
