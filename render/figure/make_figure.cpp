@@ -86,7 +86,9 @@ std::filesystem::path make_figure(const FigureRequest& r) {
   }
   std::vector<FigureRow> rows;
   if (!r.columns) {
-    for (size_t k = 0; k < runs.size(); ++k) rows.push_back({runs[k].scene.name, std::move(tiles[k]), captions[k]});
+    // One run: the sheet's title already names it.
+    for (size_t k = 0; k < runs.size(); ++k)
+      rows.push_back({runs.size() > 1 ? runs[k].scene.name : "", std::move(tiles[k]), captions[k]});
   } else {
     // Transposed: row i holds every run's i-th tile; each caption names its run (and frame).
     size_t depth = 0;

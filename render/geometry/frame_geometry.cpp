@@ -294,11 +294,18 @@ void build_cloth(const Scene& scene, const Trajectory& traj, int f, double scale
     if (c.type == "sphere") add_sphere(m, c.center, c.radius, rs.collider_color);
     if (c.type == "torus") add_torus(m, c.center, c.axis, c.radius, c.tube_radius, rs.collider_color);
   }
+  // Targets of the keyframes still to come, small beside their own spacing so a sheet of targets does
+  // not hide the cloth that reaches it.
   size_t markers = 0;
-  for (const auto& o : scene.objectives)
-    if (o.type == "position")
-      for (const Vec3& q : o.targets)
-        if (markers++ < 4096) add_marker(m, q, 0.012 * scale, rs.target_color);
+  for (const auto& o : scene.objectives) {
+    if (o.type != "position" || o.frame < f || o.targets.empty()) continue;
+    Bounds tb;
+    for (const Vec3& q : o.targets) tb.add(q);
+    const double spacing = 2 * tb.radius() / std::sqrt(double(o.targets.size()));
+    const double size = o.targets.size() > 1 ? std::min(0.012 * scale, 0.2 * spacing) : 0.012 * scale;
+    for (const Vec3& q : o.targets)
+      if (markers++ < 4096) add_marker(m, q, size, rs.target_color);
+  }
 }
 
 }  // namespace
