@@ -54,7 +54,8 @@ void add_figure_command(CLI::App& app) {
       if (!(ss >> r.width >> x >> r.height) || (x != 'x' && x != 'X') || !ss.eof())
         throw InputError("--size: expected WxH such as 400x300, got \"" + *size + "\"");
     }
-    std::cout << "figure -> " << render::make_figure(r).string() << "\n";
+    const auto path = render::make_figure(r);
+    std::cout << "figure -> " << path.string() << "\n";
   });
 }
 
