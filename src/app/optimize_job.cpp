@@ -144,6 +144,14 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     interrupted = res.interrupted;
   }
 
+  // A cape blend reports its end state against the uncontrolled run (no forces) and that run's contacts.
+  nlohmann::json uncontrolled_stats;
+  Trajectory uncontrolled;
+  if (scene.character) {
+    problem->evaluate(problem->initial_guess(), nullptr);
+    uncontrolled = frames_of(problem->rollout(), time, sys->particles());
+    for (const auto& [name, value] : sys->run_stats()) uncontrolled_stats[name] = value;
+  }
   // Re-simulate the best point to get its states, then write everything.
   problem->evaluate(z, nullptr);
   const Trajectory frames = frames_of(problem->rollout(), time, sys->particles());
@@ -175,6 +183,10 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   for (const auto& [name, value] : problem->breakdown()) terms[name] = value;
   report["final_terms"] = terms;
   for (const auto& [name, value] : sys->run_stats()) report["run_stats"][name] = value;
+  if (scene.character) {
+    report["uncontrolled_run_stats"] = uncontrolled_stats;
+    report["cape_end_state"] = cape_end_state(scene, frames, uncontrolled);
+  }
   write_json(dir / "report.json", report);
   std::ostringstream tail;
   tail << status << " after " << evaluations << " evaluations in " << std::fixed << std::setprecision(2)

@@ -17,7 +17,7 @@ bool BodyCollider::contact(int, const Vec3& x, const Vec3&, bool definite, Conta
   const double depth = thickness_ - phi;
   out.f = stiffness_ * depth * n;
   out.dfdx = -stiffness_ * n * n.transpose();
-  if (!definite && hit.feature != TriangleFeature::kFace && hit.distance > 1e-12) {
+  if (!definite && curvature_ && hit.feature != TriangleFeature::kFace && hit.distance > 1e-12) {
     const double sign = phi < 0 ? -1.0 : 1.0;
     out.dfdx += stiffness_ * depth * sign * (Mat3::Identity() - n * n.transpose()) / hit.distance;
   }
