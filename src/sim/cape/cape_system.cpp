@@ -54,6 +54,7 @@ CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, d
     extra.push_back(std::move(self));
   }
   cloth_ = std::make_unique<ClothSystem>(c, h, std::move(track), std::move(extra));
+  cloth_->set_exact_spring_adjoint(true);
   w_.setZero(3 * c.particles());
   body_count_.assign(steps + 1, 0);
   self_count_.assign(steps + 1, 0);
