@@ -12,6 +12,11 @@ bool BodyCollider::contact(int, const Vec3& x, const Vec3&, bool definite, Conta
   const BodyHit hit = query_.closest(x, std::max(thickness_, search_));
   if (!hit.found()) return false;
   const double phi = hit.signed_distance;
+  if (counting_) {
+    double m = min_phi_.load(std::memory_order_relaxed);
+    while (phi < m && !min_phi_.compare_exchange_weak(m, phi, std::memory_order_relaxed)) {
+    }
+  }
   if (phi >= thickness_ || phi < -search_) return false;
   const Vec3& n = hit.normal;
   const double depth = thickness_ - phi;

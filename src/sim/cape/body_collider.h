@@ -4,6 +4,7 @@
 //
 // The pose is set from outside once per step (set_pose refits the BVH), so contact() only reads.
 #include <atomic>
+#include <limits>
 
 #include "sim/character/body_query.h"
 #include "sim/cloth/collider.h"
@@ -35,6 +36,9 @@ class BodyCollider final : public Collider {
   // While counting is on, every contact() that finds a contact adds one to the counter.
   void set_counting(bool on) { counting_ = on; }
   int take_count() { return count_.exchange(0); }
+  // While counting is on, also the smallest signed distance (m, negative inside) met within the query
+  // radius; taking it resets it to +infinity.
+  double take_min_distance() { return min_phi_.exchange(std::numeric_limits<double>::infinity()); }
 
   const BodyQuery& query() const { return query_; }
 
@@ -44,6 +48,7 @@ class BodyCollider final : public Collider {
   bool curvature_ = false;
   bool counting_ = false;
   mutable std::atomic<int> count_{0};
+  mutable std::atomic<double> min_phi_{std::numeric_limits<double>::infinity()};
 };
 
 }  // namespace kf

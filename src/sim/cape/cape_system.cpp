@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "sim/cape/anchor_track.h"
@@ -58,6 +59,7 @@ CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, d
   w_.setZero(3 * c.particles());
   body_count_.assign(steps + 1, 0);
   self_count_.assign(steps + 1, 0);
+  min_distance_.assign(steps + 1, std::numeric_limits<double>::infinity());
 }
 
 double CapeSystem::animation_time_at(int n) const { return animation_time(spec_, n * h_ * fps_); }
@@ -90,6 +92,7 @@ void CapeSystem::prepare(int n, const VecX& x) {
 bool CapeSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) {
   prepare(n, x);
   body_->take_count();
+  body_->take_min_distance();
   body_->set_counting(true);
   if (self_) {
     self_->take_count();
@@ -98,6 +101,7 @@ bool CapeSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& 
   const bool ok = cloth_->step(n, x, v, u, x_next, v_next);
   body_->set_counting(false);
   const int nb = body_->take_count();
+  const double phi_min = body_->take_min_distance();
   int ns = 0;
   if (self_) {
     self_->set_counting(false);
@@ -106,8 +110,10 @@ bool CapeSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& 
   if (n >= int(body_count_.size())) {  // a run longer than the one the system was built for
     body_count_.resize(n + 1, 0);
     self_count_.resize(n + 1, 0);
+    min_distance_.resize(n + 1, 0.0);
   }
   body_count_[n] = nb;
+  min_distance_[n] = phi_min;
   self_count_[n] = ns;
   return ok;
 }
@@ -131,6 +137,8 @@ std::string CapeSystem::describe() const {
 
 std::vector<std::pair<std::string, double>> CapeSystem::run_stats() const {
   double body = 0, self = 0, max_body = 0, max_self = 0, contact_steps = 0;
+  double min_distance = std::numeric_limits<double>::infinity();
+  for (double d : min_distance_) min_distance = std::min(min_distance, d);
   for (size_t n = 0; n < body_count_.size(); ++n) {
     body += body_count_[n];
     self += self_count_[n];
@@ -140,7 +148,9 @@ std::vector<std::pair<std::string, double>> CapeSystem::run_stats() const {
   }
   return {{"body_contacts", body},         {"self_contacts", self},
           {"max_body_contacts", max_body}, {"max_self_contacts", max_self},
-          {"contact_steps", contact_steps}, {"cape_length", cape_length_}};
+          {"contact_steps", contact_steps}, {"cape_length", cape_length_},
+          {"min_body_distance",
+           std::isfinite(min_distance) ? min_distance : std::max(spec_.body_thickness, spec_.body_search)}};
 }
 
 std::unique_ptr<System> make_cape_system(const Scene& scene, double h) {

@@ -40,7 +40,9 @@ class CapeSystem final : public System {
   void restore_step_context(int n, const VecX& context) override { cloth_->restore_step_context(n, context); }
   std::string describe() const override;
   // Contacts of the last forward run: body_contacts (particle-steps), self_contacts (pair-steps),
-  // max_body_contacts / max_self_contacts (in one step), contact_steps, cape_length (m). Steps of a
+  // max_body_contacts / max_self_contacts (in one step), contact_steps, cape_length (m),
+  // min_body_distance (m: the smallest signed distance of a particle to the body met by the contact
+  // queries in any step; negative is penetration, and a particle farther than the query radius is not seen). Steps of a
   // diverged run after the divergence keep their earlier counts.
   std::vector<std::pair<std::string, double>> run_stats() const override;
 
@@ -66,6 +68,7 @@ class CapeSystem final : public System {
   double cape_length_;
   // Contacts found by step n of the last forward pass (a recomputed step writes the same numbers again).
   std::vector<int> body_count_, self_count_;
+  std::vector<double> min_distance_;  // smallest signed particle-body distance seen by step n (m)
 };
 
 }  // namespace kf
