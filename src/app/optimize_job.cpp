@@ -136,6 +136,40 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
                      history.push_back({stage_id, time.substeps, seconds_before + r.seconds, r});
                    },
                    &g_stop);
+    // Restarts after a stalled line search, from the best point, with what is left of the stage's budget.
+    for (int k = 0; k < scene.optimizer.restarts && !res.interrupted; ++k) {
+      const int left = stages[s].max_evaluations - int(res.history.size());
+      if (res.status.rfind("stopped: line search", 0) != 0 || left < 3) break;
+      say("restart " + std::to_string(k + 1) + " from objective " + std::to_string(res.phi) + ", " +
+          std::to_string(left) + " evaluations left");
+      OptimizerSpec rest = spec;
+      rest.max_evaluations = left;
+      const double before = res.seconds;
+      const int used = int(res.history.size());
+      const VecX best = res.z;
+      const double best_phi = res.phi;
+      OptimizeResult more = minimize(*problem, rest, best,
+                                     [&](const EvaluationRecord& r0) {
+                                       EvaluationRecord r = r0;
+                                       r.evaluation += used;
+                                       r.seconds += before;
+                                       log << format_record(stage_id, r) << "\n";
+                                       if (opt.quiet) progress.update(r.evaluation);
+                                       else std::cout << format_record(stage_id, r) << std::endl;
+                                       history.push_back({stage_id, time.substeps, seconds_before + r.seconds, r});
+                                     },
+                                     &g_stop);
+      more.seconds += before;
+      more.evaluations += res.evaluations;
+      more.history.insert(more.history.begin(), res.history.begin(), res.history.end());
+      const bool progress_made = more.phi < best_phi * (1 - 1e-6);
+      if (!(more.phi < best_phi)) {  // no progress: keep the earlier best point
+        more.z = best;
+        more.phi = best_phi;
+      }
+      res = std::move(more);
+      if (!progress_made) break;  // the gradient is no descent direction here: restarting again will not help
+    }
     progress.finish();
     z = res.z;
     seconds_before += res.seconds;
@@ -144,6 +178,14 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     interrupted = res.interrupted;
   }
 
+  // A cape blend reports its end state against the uncontrolled run (no forces) and that run's contacts.
+  nlohmann::json uncontrolled_stats;
+  Trajectory uncontrolled;
+  if (scene.character) {
+    problem->evaluate(problem->initial_guess(), nullptr);
+    uncontrolled = frames_of(problem->rollout(), time, sys->particles());
+    for (const auto& [name, value] : sys->run_stats()) uncontrolled_stats[name] = value;
+  }
   // Re-simulate the best point to get its states, then write everything.
   problem->evaluate(z, nullptr);
   const Trajectory frames = frames_of(problem->rollout(), time, sys->particles());
@@ -175,6 +217,10 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   for (const auto& [name, value] : problem->breakdown()) terms[name] = value;
   report["final_terms"] = terms;
   for (const auto& [name, value] : sys->run_stats()) report["run_stats"][name] = value;
+  if (scene.character) {
+    report["uncontrolled_run_stats"] = uncontrolled_stats;
+    report["cape_end_state"] = cape_end_state(scene, frames, uncontrolled);
+  }
   write_json(dir / "report.json", report);
   std::ostringstream tail;
   tail << status << " after " << evaluations << " evaluations in " << std::fixed << std::setprecision(2)

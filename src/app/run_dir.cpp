@@ -21,6 +21,19 @@ void prepare_run_dir(const fs::path& dir, const Scene& scene) {
   os << in.rdbuf();
   // Keep the scene's name: the copy is read back with the run directory's scene name.
   auto j = nlohmann::json::parse(os.str());
+  // A character's mesh and a cape's start and target runs are named relative to the scene's directory;
+  // the copy names them absolutely so it reads the same from the run directory (render, resume).
+  const fs::path base = fs::absolute(scene.directory.empty() ? fs::path(".") : scene.directory);
+  auto absolutise = [&](nlohmann::json& parent, const char* key) {
+    if (parent.is_object() && parent.contains(key) && parent[key].is_string())
+      parent[key] = (base / parent[key].get<std::string>()).lexically_normal().string();
+  };
+  if (j.contains("character") && j["character"].is_object()) {
+    auto& c = j["character"];
+    absolutise(c, "file");
+    if (c.contains("start")) absolutise(c["start"], "run");
+    if (c.contains("end_target")) absolutise(c["end_target"], "run");
+  }
   write_file_atomic(dir / "scene.json", j.dump(2) + "\n");
   write_file_atomic(dir / "scene_name.txt", scene.name + "\n" + fs::absolute(scene.directory.empty() ? fs::path(".") : scene.directory).string() + "\n");
 }

@@ -124,6 +124,31 @@ nlohmann::json figure_measures(const Scene& scene, const Trajectory& t) {
   return out;
 }
 
+nlohmann::json cape_end_state(const Scene& scene, const Trajectory& run, const Trajectory& uncontrolled) {
+  if (!scene.character || !scene.cloth || scene.character->target_run.empty()) return nlohmann::json();
+  // The end target is the last position and velocity objective pair the character block appended.
+  const ObjectiveSpec *pos = nullptr, *vel = nullptr;
+  for (const auto& o : scene.objectives) {
+    if (o.type == "position" && o.targets.size() > 1) pos = &o;
+    if (o.type == "velocity" && o.targets.size() > 1) vel = &o;
+  }
+  if (!pos || !vel) return nlohmann::json();
+  const double length = scene.cloth->height;
+  auto rms = [](const VecX& q, const std::vector<Vec3>& t) {
+    double sum = 0;
+    for (size_t i = 0; i < t.size(); ++i) sum += (seg(q, int(i)) - t[i]).squaredNorm();
+    return std::sqrt(sum / double(t.size()));
+  };
+  auto of = [&](const Trajectory& t) {
+    const int f = std::min(pos->frame, t.frames() - 1);
+    const double ex = rms(t.x[f], pos->targets);
+    return nlohmann::json{{"rms_position_error", ex},
+                          {"rms_position_error_percent", 100.0 * ex / length},
+                          {"rms_velocity_error", rms(t.v[std::min(vel->frame, t.frames() - 1)], vel->targets)}};
+  };
+  return {{"frame", pos->frame}, {"cape_length", length}, {"controlled", of(run)}, {"uncontrolled", of(uncontrolled)}};
+}
+
 nlohmann::json ring_measures(const ColliderSpec& torus, const Trajectory& t) {
   const TorusCollider ring(torus);
   const Vec3 axis = torus.axis.normalized();

@@ -22,6 +22,12 @@ namespace kf {
 //  is not seen.
 nlohmann::json figure_measures(const Scene& scene, const Trajectory& frames);
 
+// The cape blend's end state (scenes with a character and an end target): for the run and for the
+// uncontrolled run beside it, rms_position_error (m), rms_position_error_percent (of the cape length),
+// rms_velocity_error (m/s), at the frame of the end target; plus cape_length and frame. Null without an
+// end target.
+nlohmann::json cape_end_state(const Scene& scene, const Trajectory& run, const Trajectory& uncontrolled);
+
 // Ring measures of one torus collider over the frames of a run (the "ring" object described above).
 nlohmann::json ring_measures(const ColliderSpec& torus, const Trajectory& frames);
 

@@ -40,6 +40,9 @@ struct OptimizerSpec {
   int memory = 10;         // L-BFGS vectors
   std::vector<StageSpec> schedule;  // empty: one stage at the scene's substeps
   int checkpoint_every = 0;  // adjoint pass keeps every k-th state and recomputes the rest; 0: keep all
+  // Fresh L-BFGS starts from the best point after a stalled line search, within each stage's budget
+  // (an approximate gradient stalls the line search long before the objective stops falling).
+  int restarts = 0;
 };
 
 }  // namespace kf

@@ -82,6 +82,7 @@ OptimizerSpec parse_optimizer(Block b) {
     o.schedule.push_back(st);
   }
   o.checkpoint_every = b.integer("checkpoint_every", o.checkpoint_every, 0, 10'000'000);
+  o.restarts = b.integer("restarts", o.restarts, 0, 1000);
   b.finish();
   return o;
 }

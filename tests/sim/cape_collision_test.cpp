@@ -79,6 +79,7 @@ TEST(BodyCollider, ContactForceJacobianMatchesFiniteDifferences) {
   const double thickness = 0.01, k = 2000.0;
   BodyCollider body(ch.triangles(), ch.vertex_count(), thickness, k, 0.05);
   body.set_pose(pose);
+  body.set_curvature(true);
   std::mt19937 rng(5);
   std::uniform_int_distribution<int> pick(0, ch.triangle_count() - 1);
   int checked = 0;

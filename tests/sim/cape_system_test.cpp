@@ -85,21 +85,27 @@ struct EndTarget : StateCost {
   }
 };
 
-// The cape falls onto the crouching body; the self thickness exceeds the grid spacing so every neighbour
-// pair is a self contact and the cross blocks matter. Directional derivative along a random constant force.
-double gradient_relative_error(double self_thickness, int substeps, bool need_self) {
-  const Scene scene = parse_scene(cape_scene(5, 5, self_thickness, "[[0, 1.2], [8, 1.45]]", 8, substeps), "grad.json");
+struct Agreement {
+  double cosine, relative_error, body_contacts, self_contacts;
+};
+
+// The cape starts flat and at rest with its top edge near the shoulder anchors of the bind pose (a start
+// far from them, as the crouch, jolts the top rows, where the integrator-swapping adjoint is least
+// accurate), then the character moves into the jump: the cape meets the back and, with a self thickness
+// above the grid spacing, its neighbours push each other apart. Compared: d phi / d f for a constant force
+// f on every particle, on every third free particle's components, against central differences.
+Agreement gradient_agreement(int substeps, double self_thickness) {
+  std::string text = cape_scene(5, 5, self_thickness, "[[0, 0], [8, 0.4]]", 8, substeps);
+  text.replace(text.find("[-0.215, -0.03, -0.3]"), 21, "[-0.215, -0.03, -0.24]");
+  const Scene scene = parse_scene(text, "grad.json");
   auto sys = make_system(scene);
   const int N = scene.time.steps(), dof = sys->dof();
   VecX x0, v0;
   sys->initial_state(x0, v0);
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> U(-1, 1);
-  VecX dir(dof), force(dof);
-  for (int k = 0; k < dof; ++k) {
-    dir[k] = U(rng);
-    force[k] = 0.005 * U(rng);
-  }
+  VecX force(dof);
+  for (int k = 0; k < dof; ++k) force[k] = 0.005 * U(rng);
   EndTarget cost;
   cost.last = N;
   cost.target = x0 + VecX::Constant(dof, 0.05);
@@ -112,29 +118,95 @@ double gradient_relative_error(double self_thickness, int substeps, bool need_se
   std::vector<VecX> Uf(N, force), dU;
   EXPECT_TRUE(simulate(*sys, x0, v0, Uf, r));
   const auto stats = sys->run_stats();
-  EXPECT_GT(stats[0].second, 0) << "no body contact: the check would not cover it";
-  if (need_self) EXPECT_GT(stats[1].second, 0) << "no self contact";
   VecX dx0, dv0;
   backward(*sys, r, Uf, cost, dU, dx0, dv0);
   VecX g = VecX::Zero(dof);
   for (const VecX& d : dU) g += d;
-  const double adjoint = g.dot(dir);
-  EXPECT_GT(std::abs(adjoint), 1e-6);
-  const double eps = 1e-4;
-  const double fd = (phi(force + eps * dir) - phi(force - eps * dir)) / (2 * eps);
-  // The cloth adjoint is the approximate one of design §4 (O(h) per run); at h = 1/240 s a few percent.
-  return std::abs(adjoint - fd) / std::abs(fd);
+  std::vector<int> sample;
+  for (int i = 0; i < 20; i += 3)  // rows 0-3 are free, the top row (20-24) is pinned
+    for (int c = 0; c < 3; ++c) sample.push_back(3 * i + c);
+  VecX a(sample.size()), fd(sample.size());
+  const double eps = 1e-6;
+  for (size_t j = 0; j < sample.size(); ++j) {
+    VecX fp = force, fm = force;
+    fp[sample[j]] += eps;
+    fm[sample[j]] -= eps;
+    fd[j] = (phi(fp) - phi(fm)) / (2 * eps);
+    a[j] = g[sample[j]];
+  }
+  return {a.dot(fd) / (a.norm() * fd.norm()), (a - fd).norm() / fd.norm(), stats[0].second, stats[1].second};
 }
 
-// Disabled: measured relative errors of the directional derivative (adjoint vs central differences) are
-// 0.56 / 8.1 / 2.2 (body only) and 0.58 / 0.18 / 1.04 (body + self) at 4 / 8 / 16 substeps, and still
-// 0.39 / 0.15 / 0.47 with the body stiffness at 0: they do not fall with h, so the base cloth adjoint with
-// moving pins (or a kink in the buckling springs met by the differences) must be understood first.
-TEST(CapeSystem, DISABLED_AdjointGradientMatchesFiniteDifferencesWithContacts) {
-  for (int sub : {4, 8, 16}) {
-    std::printf("sub %d: body only %.4f, body+self %.4f\n", sub, gradient_relative_error(0.001, sub, false),
-                gradient_relative_error(0.14, sub, true));
+// The cape's own pieces (moving pins, body and self contacts with the self cross blocks) agree with finite
+// differences of one step to 1e-9 once the terms the integrator-swapping adjoint drops (the position
+// derivative of the implicit matrix times the velocity change) are added back, so what remains is that
+// approximation: it shrinks as the step does.
+TEST(CapeSystem, AdjointGradientMatchesFiniteDifferencesWithContacts) {
+  const Agreement coarse = gradient_agreement(4, 0.09), fine = gradient_agreement(16, 0.09);
+  std::printf("h = 1/120: cosine %.5f, relative error %.4f; h = 1/480: cosine %.5f, relative error %.4f "
+              "(%g body, %g self contacts)\n",
+              coarse.cosine, coarse.relative_error, fine.cosine, fine.relative_error, fine.body_contacts,
+              fine.self_contacts);
+  EXPECT_GT(fine.body_contacts, 0) << "no body contact: the check would not cover it";
+  EXPECT_GT(fine.self_contacts, 0) << "no self contact: the check would not cover it";
+  EXPECT_GE(fine.cosine, 0.99);
+  EXPECT_LT(fine.relative_error, 0.1);
+  EXPECT_LT(fine.relative_error, coarse.relative_error);
+}
+
+// One adjoint step in the middle of a run with body and self contacts, against central differences of
+// S = xhat1 . x1 + vhat1 . v1 in x, v and u. vhat and uhat are exact; xhat is exact once the terms the
+// integrator swap drops, d/dx of w^T [h^2 K(x) v1 + h D(x) dv] (w = uhat / h), are added back here.
+TEST(CapeSystem, AdjointStepIsExactUpToTheIntegratorSwap) {
+  std::string text = cape_scene(5, 5, 0.12, "[[0, 0], [8, 0.4]]", 4, 4);
+  text.replace(text.find("[-0.215, -0.03, -0.3]"), 21, "[-0.215, -0.03, -0.24]");
+  const Scene scene = parse_scene(text, "step.json");
+  auto sys = make_system(scene);
+  auto* cape = dynamic_cast<CapeSystem*>(sys.get());
+  cape->cloth().set_exact_spring_adjoint(false);  // all dropped terms are added back below
+  const int dof = sys->dof(), m = 8;
+  VecX x0, v0;
+  sys->initial_state(x0, v0);
+  Rollout r;
+  ASSERT_TRUE(simulate(*sys, x0, v0, std::vector<VecX>(m + 1, VecX::Zero(dof)), r));
+  const VecX &x = r.x[m], &v = r.v[m];
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> U(-1, 1);
+  VecX xh1(dof), vh1(dof), u = VecX::Zero(dof), x1(dof), v1(dof);
+  for (int k = 0; k < dof; ++k) xh1[k] = U(rng), vh1[k] = U(rng);
+  for (int i = 20; i < 25; ++i) seg(xh1, i).setZero(), seg(vh1, i).setZero();  // pinned: fixed next state
+  VecX xh, vh, uh;
+  sys->step_adjoint(m, x, v, u, xh1, vh1, xh, vh, uh);
+  sys->step(m, x, v, u, x1, v1);
+  const auto stats = sys->run_stats();
+  EXPECT_GT(stats[0].second + stats[1].second, 0);
+  const double h = sys->h();
+  const VecX w = uh / h, dv = v1 - v;
+  auto dropped = [&](const VecX& y) {
+    VecX a(dof), b(dof);
+    sys->step(m, y, v, u, a, b);  // the self hash and body pose of this state
+    cape->cloth().assemble(m, y, v);
+    return w.dot(h * h * (cape->cloth().stiffness_matrix() * v1) + h * (cape->cloth().damping_matrix() * dv));
+  };
+  auto S = [&](const VecX& y, const VecX& vv, const VecX& uu) {
+    VecX a(dof), b(dof);
+    sys->step(m, y, vv, uu, a, b);
+    return xh1.dot(a) + vh1.dot(b);
+  };
+  double err[3] = {0, 0, 0}, norm[3] = {0, 0, 0};
+  for (int k = 0; k < 60; ++k) {  // the free particles' coordinates
+    const double e = 1e-7;
+    VecX p = x, q = x;
+    p[k] += e, q[k] -= e;
+    const double fx = (S(p, v, u) - S(q, v, u)) / (2 * e), ax = xh[k] + (dropped(p) - dropped(q)) / (2 * e);
+    VecX pv = v, qv = v, pu = u, qu = u;
+    pv[k] += e, qv[k] -= e, pu[k] += e, qu[k] -= e;
+    const double fv = (S(x, pv, u) - S(x, qv, u)) / (2 * e), fu = (S(x, v, pu) - S(x, v, qu)) / (2 * e);
+    err[0] += (ax - fx) * (ax - fx), norm[0] += fx * fx;
+    err[1] += (vh[k] - fv) * (vh[k] - fv), norm[1] += fv * fv;
+    err[2] += (uh[k] - fu) * (uh[k] - fu), norm[2] += fu * fu;
   }
+  for (int c = 0; c < 3; ++c) EXPECT_LT(std::sqrt(err[c] / norm[c]), 1e-6) << "x, v, u"[3 * c];
 }
 
 // The shipped source scene builds and its first steps run with the cape clear of the body's inside.

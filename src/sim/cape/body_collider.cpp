@@ -12,12 +12,17 @@ bool BodyCollider::contact(int, const Vec3& x, const Vec3&, bool definite, Conta
   const BodyHit hit = query_.closest(x, std::max(thickness_, search_));
   if (!hit.found()) return false;
   const double phi = hit.signed_distance;
+  if (counting_) {
+    double m = min_phi_.load(std::memory_order_relaxed);
+    while (phi < m && !min_phi_.compare_exchange_weak(m, phi, std::memory_order_relaxed)) {
+    }
+  }
   if (phi >= thickness_ || phi < -search_) return false;
   const Vec3& n = hit.normal;
   const double depth = thickness_ - phi;
   out.f = stiffness_ * depth * n;
   out.dfdx = -stiffness_ * n * n.transpose();
-  if (!definite && hit.feature != TriangleFeature::kFace && hit.distance > 1e-12) {
+  if (!definite && curvature_ && hit.feature != TriangleFeature::kFace && hit.distance > 1e-12) {
     const double sign = phi < 0 ? -1.0 : 1.0;
     out.dfdx += stiffness_ * depth * sign * (Mat3::Identity() - n * n.transpose()) / hit.distance;
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "sim/cape/anchor_track.h"
@@ -54,7 +55,11 @@ CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, d
     extra.push_back(std::move(self));
   }
   cloth_ = std::make_unique<ClothSystem>(c, h, std::move(track), std::move(extra));
+  cloth_->set_exact_spring_adjoint(true);
   w_.setZero(3 * c.particles());
+  body_count_.assign(steps + 1, 0);
+  self_count_.assign(steps + 1, 0);
+  min_distance_.assign(steps + 1, std::numeric_limits<double>::infinity());
 }
 
 double CapeSystem::animation_time_at(int n) const { return animation_time(spec_, n * h_ * fps_); }
@@ -86,11 +91,8 @@ void CapeSystem::prepare(int n, const VecX& x) {
 
 bool CapeSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) {
   prepare(n, x);
-  if (n == 0) {
-    body_contacts_ = self_contacts_ = 0;
-    max_body_ = max_self_ = contact_steps_ = 0;
-  }
   body_->take_count();
+  body_->take_min_distance();
   body_->set_counting(true);
   if (self_) {
     self_->take_count();
@@ -99,16 +101,20 @@ bool CapeSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& 
   const bool ok = cloth_->step(n, x, v, u, x_next, v_next);
   body_->set_counting(false);
   const int nb = body_->take_count();
+  const double phi_min = body_->take_min_distance();
   int ns = 0;
   if (self_) {
     self_->set_counting(false);
     ns = self_->take_count() / 2;
   }
-  body_contacts_ += nb;
-  self_contacts_ += ns;
-  max_body_ = std::max(max_body_, nb);
-  max_self_ = std::max(max_self_, ns);
-  contact_steps_ += (nb + ns) > 0;
+  if (n >= int(body_count_.size())) {  // a run longer than the one the system was built for
+    body_count_.resize(n + 1, 0);
+    self_count_.resize(n + 1, 0);
+    min_distance_.resize(n + 1, 0.0);
+  }
+  body_count_[n] = nb;
+  min_distance_[n] = phi_min;
+  self_count_[n] = ns;
   return ok;
 }
 
@@ -130,9 +136,21 @@ std::string CapeSystem::describe() const {
 }
 
 std::vector<std::pair<std::string, double>> CapeSystem::run_stats() const {
-  return {{"body_contacts", double(body_contacts_)}, {"self_contacts", double(self_contacts_)},
-          {"max_body_contacts", double(max_body_)},  {"max_self_contacts", double(max_self_)},
-          {"contact_steps", double(contact_steps_)}, {"cape_length", cape_length_}};
+  double body = 0, self = 0, max_body = 0, max_self = 0, contact_steps = 0;
+  double min_distance = std::numeric_limits<double>::infinity();
+  for (double d : min_distance_) min_distance = std::min(min_distance, d);
+  for (size_t n = 0; n < body_count_.size(); ++n) {
+    body += body_count_[n];
+    self += self_count_[n];
+    max_body = std::max(max_body, double(body_count_[n]));
+    max_self = std::max(max_self, double(self_count_[n]));
+    contact_steps += (body_count_[n] + self_count_[n]) > 0;
+  }
+  return {{"body_contacts", body},         {"self_contacts", self},
+          {"max_body_contacts", max_body}, {"max_self_contacts", max_self},
+          {"contact_steps", contact_steps}, {"cape_length", cape_length_},
+          {"min_body_distance",
+           std::isfinite(min_distance) ? min_distance : std::max(spec_.body_thickness, spec_.body_search)}};
 }
 
 std::unique_ptr<System> make_cape_system(const Scene& scene, double h) {

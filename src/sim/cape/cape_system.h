@@ -3,8 +3,10 @@
 // shoulder anchors, pushed out of the moving body mesh and out of itself, inside the step and its adjoint.
 //
 // Step n uses the body posed at animation time animation_time(spec, n h fps) and a spatial hash of x_n.
-// Backward: the cloth's adjoint (body contact exact in K^T w) plus the self-contact cross blocks of
-// K^T w (SelfCollider::add_cross_adjoint with w = uhat / h).
+// Backward: the cloth's adjoint (body contact through its normal stiffness only, see
+// BodyCollider::set_curvature) plus the self-contact cross blocks of K^T w (SelfCollider::add_cross_adjoint
+// with w = uhat / h). Checked step by step against finite differences: the remaining difference is the
+// integrator-swapping approximation of the cloth (design §4), largest where the pins drive the cloth hard.
 #include <memory>
 #include <vector>
 
@@ -33,9 +35,15 @@ class CapeSystem final : public System {
   bool step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) override;
   void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const VecX& xhat1, const VecX& vhat1,
                     VecX& xhat, VecX& vhat, VecX& uhat) override;
+  // The cloth's PCG warm start, so checkpointed rollouts recompute cape steps bit for bit.
+  void save_step_context(int n, VecX& context) const override { cloth_->save_step_context(n, context); }
+  void restore_step_context(int n, const VecX& context) override { cloth_->restore_step_context(n, context); }
   std::string describe() const override;
   // Contacts of the last forward run: body_contacts (particle-steps), self_contacts (pair-steps),
-  // max_body_contacts / max_self_contacts (in one step), contact_steps, cape_length (m).
+  // max_body_contacts / max_self_contacts (in one step), contact_steps, cape_length (m),
+  // min_body_distance (m: the smallest signed distance of a particle to the body met by the contact
+  // queries in any step; negative is penetration, and a particle farther than the query radius is not seen). Steps of a
+  // diverged run after the divergence keep their earlier counts.
   std::vector<std::pair<std::string, double>> run_stats() const override;
 
   // Animation time (s) of step n and the posed body (3n vertices) at that step (allocates).
@@ -58,8 +66,9 @@ class CapeSystem final : public System {
   std::unique_ptr<ClothSystem> cloth_;
   VecX w_;
   double cape_length_;
-  long body_contacts_ = 0, self_contacts_ = 0;
-  int max_body_ = 0, max_self_ = 0, contact_steps_ = 0;
+  // Contacts found by step n of the last forward pass (a recomputed step writes the same numbers again).
+  std::vector<int> body_count_, self_count_;
+  std::vector<double> min_distance_;  // smallest signed particle-body distance seen by step n (m)
 };
 
 }  // namespace kf

@@ -185,6 +185,14 @@ bool ClothSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
   const PcgResult res = pcg_.solve(A_, free_, rhs_, dv_, spec_.cg_tolerance, spec_.cg_max_iterations, warm);
   last_forward_n_ = res.converged ? n : -2;
   last_cg_ = res.iterations;
+  if (exact_springs_) {
+    if (n >= int(step_dv_.size())) {
+      step_dv_.resize(n + 1);
+      step_x_.resize(n + 1);
+    }
+    step_dv_[n] = dv_;
+    step_x_[n] = x;
+  }
   v_next.resize(3 * p_);
   x_next.resize(3 * p_);
   v_next = v + dv_;
@@ -237,6 +245,46 @@ void ClothSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& 
     }
   });
   uhat = h * w;
+  if (exact_springs_ && n < int(step_dv_.size()) && step_x_[n].size() == x.size() && step_x_[n] == x)
+    add_dropped_spring_terms(x, v, step_dv_[n], xhat);
+}
+
+void ClothSystem::add_dropped_spring_terms(const VecX& x, const VecX& v, const VecX& dv, VecX& xhat) {
+  // Per spring, with K_s, D_s its off-diagonal blocks (the diagonal ones are their negatives):
+  // w^T (h^2 K c + h D dv) = -dw^T (h^2 K_s dc + h D_s ddv), dw = w_a - w_b, dc = c_a - c_b, c = v + dv.
+  // K_s, D_s depend on x_b - x_a only, so the gradient in x_b is that in x_a negated.
+  const double h = h_;
+  const VecX& w = w_;
+  xs_ = x;
+  for (int k = 0; k < int(springs_.size()); ++k) {
+    const BucklingSpring& s = springs_[k];
+    const Vec3 dw = seg(w, s.a) - seg(w, s.b);
+    if (dw.squaredNorm() == 0.0) continue;  // both ends pinned
+    const Vec3 ddv = seg(dv, s.a) - seg(dv, s.b), dc = seg(v, s.a) - seg(v, s.b) + ddv;
+    auto g = [&]() {
+      double r = -h * h * dw.dot(spring_jacobian(s, xs_, /*definite=*/true) * dc);
+      if (k < damped_) r -= h * dw.dot(damping_jacobian_v(s, spec_.damping, xs_) * ddv);
+      return r;
+    };
+    const double e = 1e-6 * s.rest, g0 = g();
+    for (int c = 0; c < 3; ++c) {
+      double& xb = xs_[3 * s.b + c];
+      const double x0 = xb;
+      xb = x0 + e;
+      const double gp = g();
+      xb = x0 - e;
+      const double gm = g();
+      xb = x0;
+      // The buckling response's stiffness jumps at the buckling load: a step across it would give the
+      // jump over e. There the two one-sided differences disagree; the smaller one is the smooth side.
+      const double up = (gp - g0) / e, down = (g0 - gm) / e;
+      const double d = std::abs(up - down) <= 0.1 * (std::abs(up) + std::abs(down)) + 1e-12
+                           ? (gp - gm) / (2 * e)
+                           : (std::abs(up) < std::abs(down) ? up : down);
+      xhat[3 * s.b + c] += d;
+      xhat[3 * s.a + c] -= d;
+    }
+  }
 }
 
 void ClothSystem::save_step_context(int n, VecX& context) const {

@@ -46,6 +46,13 @@ class ClothSystem final : public System {
   void save_step_context(int n, VecX& context) const override;
   void restore_step_context(int n, const VecX& context) override;
 
+  // Opt-in (off by default): the adjoint also carries the spring terms the integrator swap drops,
+  // d/dx of w^T [h^2 K(x) v_{n+1} + h D(x) dv] (K, D the springs' blocks of A), the position derivative of
+  // the implicit matrix met by the step's velocity change. Central differences of each spring's 3x3
+  // blocks give it; the forward pass keeps every step's dv for it. Where the pins drive the cloth hard
+  // (a cape on a moving body) the dropped terms dominate the adjoint's error.
+  void set_exact_spring_adjoint(bool on) { exact_springs_ = on; }
+
   // Evaluates forces f and the blocks of K, D and A at (x, v) of step n (the forward pass does this).
   void assemble(int n, const VecX& x, const VecX& v);
   // Results of the last assemble: f (3p, N), K (N/m), D (N s/m), A (kg), as Eigen matrices (allocate).
@@ -70,6 +77,8 @@ class ClothSystem final : public System {
     int slot;    // block (this particle, other end) in the row
   };
 
+  void add_dropped_spring_terms(const VecX& x, const VecX& v, const VecX& dv, VecX& xhat);
+
   ClothSpec spec_;
   int p_;
   double h_;
@@ -91,6 +100,9 @@ class ClothSystem final : public System {
   FilteredPcg pcg_;
   int last_cg_ = 0, last_adjoint_cg_ = 0;
   VecX w_;                                       // last adjoint solution (warm start)
+  bool exact_springs_ = false;
+  std::vector<VecX> step_dv_, step_x_;  // per step: dv and the x it was taken from (exact spring adjoint)
+  VecX xs_;                             // scratch positions for the spring differences
   int last_forward_n_ = -2, last_adjoint_n_ = -2;  // steps of the last solves, -2: none
 };
 
