@@ -99,6 +99,57 @@ TEST(ClothSpring, JacobianMatchesFiniteDifferencesInTensionAndCompression) {
   }
 }
 
+TEST(ClothSpring, JacobianMatchesFiniteDifferencesAtTinyLengths) {
+  // Squeezed to 1e-4 … 1e-8 of its rest length, just above the 1e-9 cut-off: the transverse stiffness
+  // T/s is huge and negative, and the Jacobian must still be its exact derivative. Particle a sits at
+  // the origin so the difference x_b - x_a carries no round-off from large coordinates.
+  const BucklingSpring s = test_spring();
+  std::mt19937 rng(13);
+  std::normal_distribution<double> N;
+  for (double ratio : {1e-4, 1e-6, 1e-8}) {
+    VecX x = VecX::Zero(6);
+    seg(x, 1) = ratio * s.rest * Vec3(N(rng), N(rng), N(rng)).normalized();
+    const double eps = 1e-4 * ratio * s.rest;
+    auto force = [&](const VecX& y) { return spring_force(s, y); };
+    const Mat3 B = spring_jacobian(s, x, /*definite=*/false);
+    const Mat3 fd = fd_jacobian(force, x, 1, eps);
+    ASSERT_TRUE(B.allFinite());
+    ASSERT_GT(fd.norm(), 0);
+    EXPECT_LT(relative_error(B, fd), 1e-6) << "ratio " << ratio << "\nB=\n" << B << "\nfd=\n" << fd;
+    EXPECT_LT(relative_error(-B, fd_jacobian(force, x, 0, eps)), 1e-6) << "ratio " << ratio;
+  }
+}
+
+TEST(ClothSpring, ZeroRestLengthSpringIsLinearAndIsotropicAtEveryLength) {
+  // L = 0: f_a = k d and B = k I, down to coincident particles (where d/|d| does not exist).
+  BucklingSpring s = test_spring();
+  s.rest = 0;
+  s.f_buckle = 0;
+  std::mt19937 rng(17);
+  std::normal_distribution<double> N;
+  for (double len : {0.3, 1e-6, 1e-12, 1e-170, 0.0}) {
+    VecX x(6);
+    seg(x, 0) = Vec3(N(rng), N(rng), N(rng));
+    seg(x, 1) = seg(x, 0) + len * Vec3(N(rng), N(rng), N(rng)).normalized();
+    const Vec3 f = spring_force(s, x);
+    ASSERT_TRUE(f.allFinite()) << len;
+    EXPECT_LT((f - s.k * (seg(x, 1) - seg(x, 0))).norm(), 1e-12 * s.k) << len;
+    for (bool definite : {false, true}) {
+      const Mat3 B = spring_jacobian(s, x, definite);
+      ASSERT_TRUE(B.allFinite()) << len;
+      EXPECT_LT((B - s.k * Mat3::Identity()).norm(), 1e-12 * s.k) << len;
+    }
+    // Finite differences straddle the coincident point too: the force is linear there.
+    const Mat3 fd = fd_jacobian([&](const VecX& y) { return spring_force(s, y); }, x, 1, 1e-6);
+    EXPECT_LT(relative_error(spring_jacobian(s, x, false), fd), 1e-8) << len;
+    // Damping along an undefined direction is 0, never NaN.
+    const VecX v = VecX::Ones(6);
+    EXPECT_TRUE(damping_force(s, 0.1, x, v).allFinite()) << len;
+    EXPECT_TRUE(damping_jacobian_v(s, 0.1, x).allFinite()) << len;
+    EXPECT_TRUE(damping_jacobian_x(s, 0.1, x, v).allFinite()) << len;
+  }
+}
+
 TEST(ClothSpring, DefiniteJacobianIsPositiveSemidefinite) {
   const BucklingSpring s = test_spring();
   std::mt19937 rng(3);

@@ -24,19 +24,23 @@ void spring_tension(const BucklingSpring& sp, double s, double& T, double& dT_ds
 
 Vec3 spring_force(const BucklingSpring& sp, const VecX& x) {
   const Vec3 d = seg(x, sp.b) - seg(x, sp.a);
+  // Zero rest length: T/s = k at every length, so the force k d needs no direction (s = 0 included).
+  if (sp.rest == 0) return sp.k * d;
   const double s = d.norm();
-  if (s < kDegenerate * sp.rest) return Vec3::Zero();
+  if (s <= kDegenerate * sp.rest) return Vec3::Zero();
   double T, dT;
   spring_tension(sp, s, T, dT);
   return (T / s) * d;
 }
 
 Mat3 spring_jacobian(const BucklingSpring& sp, const VecX& x, bool definite) {
+  // Zero rest length: dT/ds = T/s = k, so the axial and transverse parts agree and B = k I exactly.
+  if (sp.rest == 0) return sp.k * Mat3::Identity();
   const Vec3 d = seg(x, sp.b) - seg(x, sp.a);
   const double s = d.norm();
   double T, dT;
   spring_tension(sp, s, T, dT);
-  if (s < kDegenerate * sp.rest) return dT * Mat3::Identity();
+  if (s <= kDegenerate * sp.rest) return dT * Mat3::Identity();
   const Vec3 n = d / s;
   const Mat3 nn = n * n.transpose();
   const double transverse = (definite && T < 0) ? 0.0 : T / s;

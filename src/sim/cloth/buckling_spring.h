@@ -30,7 +30,9 @@ Vec3 spring_force(const BucklingSpring& sp, const VecX& x);
 // B = d(force on a)/d(x_b) (3x3, N/m). The spring's 6x6 stiffness is [[-B, B], [B, -B]] (B symmetric).
 // `definite` drops the compressive part of the transverse term (T < 0), which keeps -K positive
 // semi-definite so the implicit matrix stays SPD; the exact Jacobian is definite = false.
-// Springs shorter than 1e-9 L have no direction: force 0 and B = dT/ds I (finite, never NaN).
+// Springs shorter than 1e-9 L (L > 0) have no direction: force 0 and B = dT/ds I (finite, never NaN).
+// A zero-rest-length spring (L = 0) is the linear spring f_a = k d with B = k I at every length, s = 0
+// included: its axial and transverse stiffnesses are both k, so the direction never enters.
 Mat3 spring_jacobian(const BucklingSpring& sp, const VecX& x, bool definite);
 
 }  // namespace kf

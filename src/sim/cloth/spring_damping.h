@@ -1,6 +1,8 @@
 #pragma once
 // Damping along a spring: resists the rate at which its two ends separate, not rigid motion.
 // Force on a: c (n . (v_b - v_a)) n with n = (x_b - x_a)/|x_b - x_a|; on b its negative.
+// A spring without a direction (|x_b - x_a| <= 1e-9 L, or exactly 0 when L = 0) is not damped: force and
+// Jacobians 0.
 #include "core/types.h"
 #include "sim/cloth/buckling_spring.h"
 
