@@ -5,24 +5,18 @@
 namespace kf {
 
 namespace {
-VecX scene_initial_position(System& sys) {
-  VecX x, v;
-  sys.initial_state(x, v);
+// Initial positions, with the initial velocities written into v0.
+VecX initial_positions(const System& sys, VecX& v0) {
+  VecX x;
+  sys.initial_state(x, v0);
   return x;
-}
-VecX scene_initial_velocity(System& sys) {
-  VecX x, v;
-  sys.initial_state(x, v);
-  return v;
 }
 }  // namespace
 
 Problem::Problem(const Scene& scene, const TimeSpec& time, System& sys)
-    : time_(time), sys_(sys),
-      controls_(scene.controls, time, sys.particles(), sys.planar(), scene_initial_position(sys),
-                scene_initial_velocity(sys)),
+    : time_(time), sys_(sys), x0_(initial_positions(sys, v0_scene_)),
+      controls_(scene.controls, time, sys.particles(), sys.planar(), x0_, v0_scene_),
       checkpoint_every_(scene.optimizer.checkpoint_every) {
-  sys_.initial_state(x0_, v0_scene_);
   terms_at_step_.resize(time_.steps() + 1);
   for (const auto& spec : scene.objectives) {
     terms_.push_back(make_objective_term(spec, sys.particles()));

@@ -48,10 +48,11 @@ class Problem : public StateCost {
  private:
   TimeSpec time_;
   System& sys_;
+  VecX v0_scene_, x0_;  // the scene's initial state, read once; controls_ is built from it
   Controls controls_;
   std::vector<std::unique_ptr<ObjectiveTerm>> terms_;
   std::vector<std::vector<int>> terms_at_step_;  // term indices per step
-  VecX x0_, v0_scene_, v0_;
+  VecX v0_;
   VecX u_;  // control force of the step being simulated
   int checkpoint_every_ = 0;
   VecX dx0_, dv0_;
