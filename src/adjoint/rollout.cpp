@@ -16,6 +16,12 @@ void ensure_size(VecX& a, int n) {
   if (a.size() != n) a.resize(n);
 }
 
+// Grows `tape` to n entries of the system's record type, keeping the ones there (they own work space).
+void ensure_tape(const System& sys, std::vector<std::unique_ptr<StepRecord>>& tape, int n) {
+  if (int(tape.size()) > n) tape.resize(n);
+  while (int(tape.size()) < n) tape.push_back(sys.new_record());
+}
+
 }  // namespace
 
 bool simulate(System& sys, const VecX& x0, const VecX& v0, int N, const StepControl& u, Rollout& r,
@@ -39,6 +45,8 @@ bool simulate(System& sys, const VecX& x0, const VecX& v0, int N, const StepCont
     }
   }
   r.context.resize(every > 0 ? (N + every - 1) / every + 1 : 0);
+  // Checkpointed: steps record into one scratch entry; the backward pass records its segments again.
+  ensure_tape(sys, r.tape, every > 0 ? 1 : N);
   r.x[0] = x0;
   r.v[0] = v0;
   // States not kept alternate between two scratch pairs so a step never reads what it writes.
@@ -53,7 +61,8 @@ bool simulate(System& sys, const VecX& x0, const VecX& v0, int N, const StepCont
     if (every > 0 && n % every == 0) sys.save_step_context(n, r.context[n / every]);
     VecX& xn = r.kept(n + 1) ? r.x[n + 1] : scratch_x[n & 1];
     VecX& vn = r.kept(n + 1) ? r.v[n + 1] : scratch_v[n & 1];
-    if (!sys.step(n, *xc, *vc, u(n), xn, vn)) {
+    StepRecord& record = *r.tape[every > 0 ? 0 : n];
+    if (!sys.step(n, *xc, *vc, u(n), xn, vn, record)) {
       r.diverged_at = n;
       return false;
     }
@@ -82,24 +91,29 @@ void backward(System& sys, const Rollout& r, const StepControl& u, const StateCo
   const int every = r.every > 0 ? r.every : N + 1;
   VecX xhat = VecX::Zero(dof), vhat = VecX::Zero(dof), xhat_prev(dof), vhat_prev(dof), uhat(dof);
   if (cost.active(N)) cost.eval(N, r.x[N], r.v[N], xhat, vhat);
-  // Segment buffers: states k .. e-1 of the segment being walked back (checkpointed mode only).
-  std::vector<VecX> seg_x(r.every > 0 ? every : 0), seg_v(seg_x.size());
+  // Segment buffers: states k .. e of the segment being walked back and its tape (checkpointed mode only).
+  std::vector<VecX> seg_x(r.every > 0 ? every + 1 : 0), seg_v(seg_x.size());
   for (auto& s : seg_x) s.resize(dof);
   for (auto& s : seg_v) s.resize(dof);
+  std::vector<std::unique_ptr<StepRecord>> seg_tape;
+  if (r.every > 0) ensure_tape(sys, seg_tape, every);
   const int last_start = r.every > 0 ? ((N - 1) / every) * every : 0;
   for (int k = last_start; k >= 0; k -= every) {
     const int e = std::min(k + every, N);
     auto state_x = [&](int n) -> const VecX& { return r.every > 0 ? seg_x[n - k] : r.x[n]; };
     auto state_v = [&](int n) -> const VecX& { return r.every > 0 ? seg_v[n - k] : r.v[n]; };
+    auto record = [&](int n) -> const StepRecord& { return r.every > 0 ? *seg_tape[n - k] : *r.tape[n]; };
     if (r.every > 0) {
-      // Recompute states k+1 .. e-1 from the checkpoint, in the original step context.
+      // Recompute steps k .. e-1 from the checkpoint, in the original step context, for their states and
+      // tape (state e is recomputed too, and equals the kept one bit for bit).
       seg_x[0] = r.x[k];
       seg_v[0] = r.v[k];
       sys.restore_step_context(k, r.context[k / every]);
-      for (int n = k; n + 1 < e; ++n) sys.step(n, seg_x[n - k], seg_v[n - k], u(n), seg_x[n - k + 1], seg_v[n - k + 1]);
+      for (int n = k; n < e; ++n)
+        sys.step(n, seg_x[n - k], seg_v[n - k], u(n), seg_x[n - k + 1], seg_v[n - k + 1], *seg_tape[n - k]);
     }
     for (int n = e - 1; n >= k; --n) {
-      sys.step_adjoint(n, state_x(n), state_v(n), u(n), xhat, vhat, xhat_prev, vhat_prev, uhat);
+      sys.step_adjoint(n, state_x(n), state_v(n), u(n), record(n), xhat, vhat, xhat_prev, vhat_prev, uhat);
       du(n, uhat);
       xhat.swap(xhat_prev);
       vhat.swap(vhat_prev);

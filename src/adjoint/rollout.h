@@ -1,15 +1,18 @@
 #pragma once
 // Forward simulation and the adjoint pass that walks it backwards, with optional checkpointing.
 //
-// Stored mode (checkpoint_every = 0) keeps all N+1 states. Checkpointed mode keeps every k-th state
-// (plus the system's step context there, e.g. a PCG warm start), the last state and the states a cost
-// reads; the backward pass recomputes each segment of k steps from its checkpoint into a k-state buffer.
+// Every step writes a tape entry (System::StepRecord) that its adjoint step reads.
+// Stored mode (checkpoint_every = 0) keeps all N+1 states and all N tape entries. Checkpointed mode keeps
+// every k-th state (plus the system's step context there, e.g. a PCG warm start), the last state and the
+// states a cost reads, and no tape; the backward pass recomputes each segment of k steps from its
+// checkpoint into a k-state buffer and a k-entry tape.
 // Memory for states falls from (N+1) to about N/k + k + (cost steps) states, at the price of about one
 // more forward pass. Recomputed states are bit-identical to the originals (same steps, same inputs,
 // same step context), so both modes give the same gradient bit for bit.
 #include <cstddef>
 #include <algorithm>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "core/types.h"
@@ -20,12 +23,13 @@ namespace kf {
 // States of one simulation of N steps: x[n], v[n] (3p each) where kept, empty (size 0) where not.
 struct Rollout {
   std::vector<VecX> x, v;
+  std::vector<std::unique_ptr<StepRecord>> tape;  // entry n written by step n (stored mode; else empty)
   std::vector<VecX> context;  // step context saved before step c*every, per checkpoint c (checkpointed)
   int every = 0;              // checkpoint spacing in steps; 0 = every state kept
   int diverged_at = -1;       // first step whose result was not finite, or -1
   int steps() const { return int(x.size()) - 1; }
   bool kept(int n) const { return x[n].size() > 0; }
-  // Bytes held by the state vectors and step contexts (what checkpointing saves).
+  // Bytes held by the state vectors and step contexts (what checkpointing saves; the tape is not counted).
   std::size_t stored_bytes() const;
 };
 

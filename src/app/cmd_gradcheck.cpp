@@ -20,6 +20,7 @@ void add_gradcheck_command(CLI::App& app) {
     int samples = 40, frames = 0, substeps = 0;
     double eps = 1e-2, dt = 0, perturb = 0.1;
     unsigned seed = 7;
+    std::string adjoint;
   };
   auto o = std::make_shared<Options>();
   sub->add_option("SCENE", o->scene, "scene file (JSON)")->required();
@@ -33,6 +34,9 @@ void add_gradcheck_command(CLI::App& app) {
   sub->add_option("--perturb", o->perturb, "scale of the random controls the check is made at")
       ->check(CLI::Range(0.0, 1e6));
   sub->add_option("--seed", o->seed, "seed for the sample and the controls");
+  sub->add_option("--adjoint", o->adjoint, "cloth adjoint: exact (the step's own Jacobian) or swap (the paper's "
+                                           "integrator swap); default: the scene's optimizer.adjoint")
+      ->check(CLI::IsMember({"exact", "swap"}));
   sub->callback([o] {
     Scene scene = load_scene(o->scene);
     if (o->frames > 0 && o->frames < scene.time.frames) {
@@ -41,6 +45,7 @@ void add_gradcheck_command(CLI::App& app) {
       scene.time.frames = o->frames;
     }
     if (o->substeps > 0) scene.time.substeps = o->substeps;
+    if (!o->adjoint.empty()) scene.optimizer.adjoint = o->adjoint;
     if (o->dt > 0) {
       const double n = 1.0 / (scene.time.fps * o->dt);
       if (std::abs(n - std::round(n)) > 1e-6 || std::round(n) < 1)
@@ -60,6 +65,7 @@ void add_gradcheck_command(CLI::App& app) {
     j["h"] = scene.time.h();
     j["steps"] = scene.time.steps();
     j["control_variables"] = problem.size();
+    j["adjoint"] = scene.optimizer.adjoint;
     std::cout << j.dump() << "\n";
   });
 }

@@ -150,7 +150,7 @@ nlohmann::json cape_end_state(const Scene& scene, const Trajectory& run, const T
 }
 
 nlohmann::json ring_measures(const ColliderSpec& torus, const Trajectory& t) {
-  const TorusCollider ring(torus);
+  const TorusCollider ring(torus, 0.0);  // distances only
   const Vec3 axis = torus.axis.normalized();
   const double inner = torus.radius - torus.tube_radius;
   double min_phi = std::numeric_limits<double>::infinity();

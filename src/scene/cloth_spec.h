@@ -42,6 +42,11 @@ struct ClothSpec {
   double cg_tolerance = 1e-8;           // PCG stops when |r| <= cg_tolerance * |b| (filtered)
   int cg_max_iterations = 1000;         // PCG failing to converge within this fails the step
   std::string cg_preconditioner = "incomplete_cholesky";  // or "block_jacobi"
+  // A step that gains energy is split in halves, at most this many times (0: never split).
+  int max_halvings = 8;
+  // Every contact's stiffness rises from 0 to full over this fraction of its thickness (ContactProfile);
+  // 0: the linear penalty, whose stiffness jumps where contact begins.
+  double contact_ramp = 0.5;
   std::vector<ColliderSpec> colliders;
 
   int particles() const { return nx * ny; }

@@ -43,6 +43,8 @@ struct OptimizerSpec {
   // Fresh L-BFGS starts from the best point after a stalled line search, within each stage's budget
   // (an approximate gradient stalls the line search long before the objective stops falling).
   int restarts = 0;
+  // Cloth adjoint: "exact" (the transpose of the step's Jacobian) or "swap" (the paper's integrator swap).
+  std::string adjoint = "exact";
 };
 
 }  // namespace kf

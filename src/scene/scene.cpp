@@ -83,6 +83,7 @@ OptimizerSpec parse_optimizer(Block b) {
   }
   o.checkpoint_every = b.integer("checkpoint_every", o.checkpoint_every, 0, 10'000'000);
   o.restarts = b.integer("restarts", o.restarts, 0, 1000);
+  o.adjoint = b.string("adjoint", o.adjoint, {"exact", "swap"});
   b.finish();
   return o;
 }

@@ -4,6 +4,7 @@
 // State: positions x and velocities v, 3p entries each (metres, m/s, world frame, Y up).
 // Controls: an external force u_n (3p, newtons) applied during step n (n = 0 .. steps-1).
 // The step length h is fixed when the system is built from a scene.
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -11,6 +12,12 @@
 #include "core/types.h"
 
 namespace kf {
+
+// What one forward step leaves for its adjoint: one entry of a rollout's tape. Each system derives its own
+// (the cloth keeps the step's velocity change, the flock its neighbour lists); the base records nothing.
+struct StepRecord {
+  virtual ~StepRecord() = default;
+};
 
 class System {
  public:
@@ -26,18 +33,37 @@ class System {
   // True for flocks that live on the ground plane: the y components of x, v and u stay zero.
   virtual bool planar() const { return false; }
 
-  // Advances the state of step n by one step under control force u. Returns false when the result is
-  // not finite or an inner solve failed; the caller treats that as a diverged simulation.
-  // x_next and v_next arrive sized 3p. Must not allocate after the first call.
-  virtual bool step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) = 0;
+  // A fresh tape entry for this system's steps.
+  virtual std::unique_ptr<StepRecord> new_record() const { return std::make_unique<StepRecord>(); }
 
-  // Adjoint of step n, evaluated at the forward state (x, v) of step n and its control u.
+  // Advances the state of step n by one step under control force u and writes what its adjoint needs to
+  // `record`. Returns false when the result is not finite or an inner solve failed; the caller treats
+  // that as a diverged simulation. x_next and v_next arrive sized 3p. Must not allocate after the first
+  // call with the same record.
+  virtual bool step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next,
+                    StepRecord& record) = 0;
+
+  // Adjoint of step n, evaluated at the forward state (x, v) of step n, its control u and the record its
+  // forward step wrote.
   // In:  xhat1, vhat1 = dphi/dx_{n+1}, dphi/dv_{n+1} (complete, including keyframe terms at n+1).
   // Out: xhat, vhat   = the part of dphi/dx_n, dphi/dv_n that flows through this step
   //                     (the caller adds the keyframe gradient of step n),
   //      uhat         = dphi/du_n through the dynamics (the caller adds the effort term alpha*u_n).
-  virtual void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const VecX& xhat1,
-                            const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) = 0;
+  virtual void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const StepRecord& record,
+                            const VecX& xhat1, const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) = 0;
+
+  // The same without a tape, for single steps outside a rollout: the step records into a scratch entry,
+  // and the adjoint first repeats the forward step to record it.
+  bool step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) {
+    return step(n, x, v, u, x_next, v_next, scratch_record());
+  }
+  void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const VecX& xhat1, const VecX& vhat1,
+                    VecX& xhat, VecX& vhat, VecX& uhat) {
+    VecX x1(x.size()), v1(v.size());
+    StepRecord& r = scratch_record();
+    step(n, x, v, u, x1, v1, r);
+    step_adjoint(n, x, v, u, r, xhat1, vhat1, xhat, vhat, uhat);
+  }
 
   // Solver state besides (x, v) that step n depends on (e.g. a PCG warm start carried over from step
   // n-1), so that a step recomputed from a checkpoint repeats the original bit for bit. Saved just
@@ -51,6 +77,13 @@ class System {
 
   // Named counters of the last forward simulation for run reports (a cape's collision contacts).
   virtual std::vector<std::pair<std::string, double>> run_stats() const { return {}; }
+
+ private:
+  StepRecord& scratch_record() {
+    if (!scratch_) scratch_ = new_record();
+    return *scratch_;
+  }
+  std::unique_ptr<StepRecord> scratch_;
 };
 
 }  // namespace kf

@@ -27,14 +27,16 @@ class ToySystem : public System {
       f.segment<3>(3 * i + 3) += k_ * d;
     }
   }
-  bool step(int, const VecX& x, const VecX& v, const VecX& u, VecX& x1, VecX& v1) override {
+  using System::step;
+  using System::step_adjoint;
+  bool step(int, const VecX& x, const VecX& v, const VecX& u, VecX& x1, VecX& v1, StepRecord&) override {
     force(x, v, f_);
     for (int i = 0; i < p_; ++i) v1.segment<3>(3 * i) = v.segment<3>(3 * i) + h_ / m_[i] * (f_.segment<3>(3 * i) + u.segment<3>(3 * i));
     x1 = x + h_ * v1;
     return v1.allFinite() && u.cwiseAbs().maxCoeff() < limit_;
   }
-  void step_adjoint(int, const VecX&, const VecX&, const VecX&, const VecX& xhat1, const VecX& vhat1, VecX& xhat,
-                    VecX& vhat, VecX& uhat) override {
+  void step_adjoint(int, const VecX&, const VecX&, const VecX&, const StepRecord&, const VecX& xhat1,
+                    const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) override {
     VecX s = vhat1 + h_ * xhat1;
     VecX ms(3 * p_);
     for (int i = 0; i < p_; ++i) ms.segment<3>(3 * i) = s.segment<3>(3 * i) / m_[i];

@@ -15,7 +15,8 @@ double relative_error(const Mat3& a, const Mat3& fd) {
   return ((a - fd).cwiseAbs().array() / fd.cwiseAbs().array().max(floor)).maxCoeff();
 }
 
-// Checks the exact Jacobian at x (which must be in contact) and that the definite one is NSD.
+// Checks the exact Jacobian at x (which must be in contact), that the definite one is NSD, and the
+// derivative of the definite one met by two vectors.
 void check_contact(const Collider& c, const Vec3& x, const char* what) {
   ContactForce out;
   ASSERT_TRUE(c.contact(0, x, Vec3::Zero(), false, out)) << what << " at " << x.transpose();
@@ -38,6 +39,49 @@ void check_contact(const Collider& c, const Vec3& x, const char* what) {
   EXPECT_EQ(def.f, out.f);
   Eigen::SelfAdjointEigenSolver<Mat3> eig(def.dfdx);
   EXPECT_LE(eig.eigenvalues().maxCoeff(), 1e-9) << what;
+  const Vec3 w(0.3, -0.7, 0.5), cv(-0.2, 0.4, 0.9);
+  const Vec3 dk = c.definite_stiffness_derivative(0, x, w, cv);
+  Vec3 fdk;
+  for (int k = 0; k < 3; ++k) {
+    Vec3 xp = x, xm = x;
+    xp[k] += eps;
+    xm[k] -= eps;
+    ContactForce p, m;
+    c.contact(0, xp, Vec3::Zero(), true, p);
+    c.contact(0, xm, Vec3::Zero(), true, m);
+    fdk[k] = (w.dot(p.dfdx * cv) - w.dot(m.dfdx * cv)) / (2 * eps);
+  }
+  EXPECT_LT((dk - fdk).norm(), 1e-5 * std::max(fdk.norm(), 1.0)) << what << "\n" << dk.transpose() << "\n"
+                                                                   << fdk.transpose();
+}
+
+TEST(ContactProfile, StiffnessRisesSmoothlyAndMatchesItsDerivatives) {
+  const ContactProfile p{1e4, 0.01};
+  double g, dg, ddg, gp, dgp, ddgp, gm, dgm, ddgm;
+  p.eval(-1e-3, g, dg, ddg);
+  EXPECT_EQ(g + dg + ddg, 0.0);
+  p.eval(1e-12, g, dg, ddg);  // where contact begins: no jump in force or stiffness
+  EXPECT_LT(g, 1e-15);
+  EXPECT_LT(dg, 1e-10);
+  p.eval(0.01 * (1 - 1e-9), gm, dgm, ddgm);  // the end of the ramp
+  p.eval(0.01 * (1 + 1e-9), gp, dgp, ddgp);
+  EXPECT_NEAR(gm, gp, 1e-6);
+  EXPECT_NEAR(dgm, dgp, 1e-3);
+  EXPECT_NEAR(gp, 1e4 * 0.005, 1e-6);
+  for (double d : {0.001, 0.004, 0.0099, 0.02}) {
+    const double e = 1e-8;
+    p.eval(d, g, dg, ddg);
+    p.eval(d + e, gp, dgp, ddgp);
+    p.eval(d - e, gm, dgm, ddgm);
+    EXPECT_NEAR(dg, (gp - gm) / (2 * e), 1e-5 * 1e4) << d;
+    EXPECT_NEAR(ddg, (dgp - dgm) / (2 * e), 1e-5 * 1e6) << d;
+    EXPECT_NEAR(g, (p.energy(d + e) - p.energy(d - e)) / (2 * e), 1e-6 * 1e4 * d) << d;
+  }
+  EXPECT_EQ(p.energy(0.0), 0.0);
+  const ContactProfile linear{1e4, 0.0};
+  linear.eval(0.003, g, dg, ddg);
+  EXPECT_DOUBLE_EQ(g, 30.0);
+  EXPECT_DOUBLE_EQ(dg, 1e4);
 }
 
 ColliderSpec spec(const std::string& type) {
@@ -54,8 +98,8 @@ ColliderSpec spec(const std::string& type) {
 
 TEST(ClothCollider, GroundJacobianAndSeparation) {
   const ColliderSpec s = spec("ground");
-  GroundCollider g(s);
-  check_contact(g, s.center + 0.01 * s.axis + Vec3(0.3, 0, 0.1).cross(s.axis), "ground");
+  GroundCollider g(s, 0.5 * s.thickness);
+  check_contact(g, s.center + 0.013 * s.axis + Vec3(0.3, 0, 0.1).cross(s.axis), "ground");
   check_contact(g, s.center - 0.05 * s.axis, "ground (penetrating)");
   ContactForce out;
   EXPECT_FALSE(g.contact(0, s.center + 0.03 * s.axis, Vec3::Zero(), false, out));
@@ -63,7 +107,7 @@ TEST(ClothCollider, GroundJacobianAndSeparation) {
 
 TEST(ClothCollider, SphereJacobianMatchesFiniteDifferences) {
   const ColliderSpec s = spec("sphere");
-  SphereCollider c(s);
+  SphereCollider c(s, 0.5 * s.thickness);
   std::mt19937 rng(2);
   std::normal_distribution<double> N;
   std::uniform_real_distribution<double> U(-0.9, 0.9);
@@ -79,7 +123,7 @@ TEST(ClothCollider, SphereJacobianMatchesFiniteDifferences) {
 
 TEST(ClothCollider, TorusJacobianMatchesFiniteDifferences) {
   const ColliderSpec s = spec("torus");
-  TorusCollider c(s);
+  TorusCollider c(s, 0.5 * s.thickness);
   const Vec3 a = s.axis;
   const Vec3 e1 = a.unitOrthogonal(), e2 = a.cross(e1);
   std::mt19937 rng(4);
@@ -99,8 +143,8 @@ TEST(ClothCollider, TorusJacobianMatchesFiniteDifferences) {
 }
 
 TEST(ClothCollider, FactoryBuildsOnePerSpecAndNoneForNone) {
-  EXPECT_TRUE(make_colliders({}).empty());
-  auto cs = make_colliders({spec("ground"), spec("sphere"), spec("torus")});
+  EXPECT_TRUE(make_colliders({}, 0.5).empty());
+  auto cs = make_colliders({spec("ground"), spec("sphere"), spec("torus")}, 0.5);
   ASSERT_EQ(cs.size(), 3u);
   EXPECT_NE(dynamic_cast<TorusCollider*>(cs[2].get()), nullptr);
 }

@@ -56,28 +56,58 @@ VecX pair_at(double ratio, double rest, std::mt19937& rng) {
   return x;
 }
 
-TEST(ClothSpring, TensionIsC1AndMatchesItsSlope) {
+TEST(ClothSpring, TensionIsC1AndMatchesItsSlopeAndCurvature) {
   const BucklingSpring s = test_spring();
-  double T, dT, Tp, dTp, Tm, dTm;
-  spring_tension(s, s.rest * 1.1, T, dT);
+  double T, dT, d2T, Tp, dTp, d2Tp, Tm, dTm, d2Tm;
+  spring_tension(s, s.rest * 1.1, T, dT, d2T);
   EXPECT_NEAR(T, s.k * 0.1 * s.rest, 1e-12);
+  EXPECT_EQ(d2T, 0.0);
   // Slope continuous at the rest length (no kink for the optimiser).
-  spring_tension(s, s.rest * (1 + 1e-12), Tp, dTp);
-  spring_tension(s, s.rest * (1 - 1e-12), Tm, dTm);
+  spring_tension(s, s.rest * (1 + 1e-12), Tp, dTp, d2Tp);
+  spring_tension(s, s.rest * (1 - 1e-12), Tm, dTm, d2Tm);
   EXPECT_NEAR(dTp, dTm, 1e-6 * s.k);
   // Deep compression: force near the buckling load, stiffness near the post-buckling stiffness.
-  spring_tension(s, s.rest * 0.5, T, dT);
+  spring_tension(s, s.rest * 0.5, T, dT, d2T);
   EXPECT_LT(T, -s.f_buckle);
   EXPECT_NEAR(dT, s.k_post, 1e-6 * s.k);
   for (double ratio : {1.3, 1.0001, 0.9999, 0.998, 0.95, 0.6, 0.05}) {
     const double L = s.rest * ratio, eps = 1e-8;
-    spring_tension(s, L, T, dT);
-    spring_tension(s, L + eps, Tp, dTp);
-    spring_tension(s, L - eps, Tm, dTm);
+    spring_tension(s, L, T, dT, d2T);
+    spring_tension(s, L + eps, Tp, dTp, d2Tp);
+    spring_tension(s, L - eps, Tm, dTm, d2Tm);
     ASSERT_GT(std::abs(dT), 0);
     EXPECT_NEAR(dT, (Tp - Tm) / (2 * eps), 1e-6 * s.k) << "ratio " << ratio;
+    EXPECT_NEAR(d2T, (dTp - dTm) / (2 * eps), 1e-6 * std::max(std::abs(d2T), s.k / s.rest)) << "ratio " << ratio;
     EXPECT_GE(dT, 0);
   }
+}
+
+TEST(ClothSpring, EnergyIsZeroAtRestAndItsGradientIsMinusTheForce) {
+  const BucklingSpring s = test_spring();
+  std::mt19937 rng(3);
+  EXPECT_LT(spring_energy(s, pair_at(1.0, s.rest, rng)), 1e-20);  // at rest up to rounding
+  for (double ratio : {1.25, 1.01, 0.999, 0.99, 0.9, 0.5, 0.1}) {
+    const VecX x = pair_at(ratio, s.rest, rng);
+    EXPECT_GT(spring_energy(s, x), 0) << "ratio " << ratio;
+    // d(energy)/d(x_a) = -(force on a), by central differences.
+    const double eps = 1e-7 * s.rest;
+    Vec3 grad;
+    for (int k = 0; k < 3; ++k) {
+      VecX xp = x, xm = x;
+      xp[k] += eps;
+      xm[k] -= eps;
+      grad[k] = (spring_energy(s, xp) - spring_energy(s, xm)) / (2 * eps);
+    }
+    const Vec3 f = spring_force(s, x);
+    ASSERT_GT(f.norm(), 0);
+    EXPECT_LT((grad + f).norm(), 1e-6 * f.norm()) << "ratio " << ratio << ": " << grad.transpose() << " vs "
+                                                  << -f.transpose();
+  }
+  // Zero rest length: k |d|^2 / 2.
+  BucklingSpring z = s;
+  z.rest = 0;
+  const VecX x = pair_at(1.0, 0.3, rng);
+  EXPECT_NEAR(spring_energy(z, x), 0.5 * z.k * 0.09, 1e-12);
 }
 
 TEST(ClothSpring, JacobianMatchesFiniteDifferencesInTensionAndCompression) {

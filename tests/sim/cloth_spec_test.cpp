@@ -52,7 +52,7 @@ TEST(ClothSpec, CollidersAndErrorsNameTheirPlace) {
           "tube_radius": 0.02, "axis": [0, 0, 2]}]})");
   ASSERT_EQ(s.cloth->colliders.size(), 2u);
   EXPECT_EQ(s.cloth->colliders[1].axis, Vec3(0, 0, 1));
-  EXPECT_EQ(make_system(s)->describe(), "cloth: 16x16 particles, 1378 springs, 0 pinned, 2 colliders, PCG (incomplete_cholesky)");
+  EXPECT_EQ(make_system(s)->describe(), "cloth: 16x16 particles, 1378 springs, 0 pinned, 2 colliders, PCG (incomplete_cholesky), exact adjoint");
   EXPECT_EQ(scene_with(R"({"cg_preconditioner": "block_jacobi"})").cloth->cg_preconditioner, "block_jacobi");
   EXPECT_NE(error_of(R"({"cg_preconditioner": "ilu"})").find("/cloth/cg_preconditioner: expected one of"),
             std::string::npos);

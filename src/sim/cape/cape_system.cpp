@@ -28,6 +28,9 @@ CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, d
       cape_length_(cloth.height) {
   ClothSpec c = cloth;
   c.pins = named_pin_set("top_edge", c.nx, c.ny);
+  // The moving body does work on the cape that a step's energy check cannot account for, so cape steps
+  // are never split (its scenes use small steps).
+  c.max_halvings = 0;
   std::vector<double> params;
   for (int k = 0; k < int(c.pins.size()); ++k) params.push_back(c.nx > 1 ? double(k) / (c.nx - 1) : 0.5);
 
@@ -46,17 +49,17 @@ CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, d
 
   std::vector<std::unique_ptr<Collider>> extra;
   auto body = std::make_unique<BodyCollider>(character_.triangles(), character_.vertex_count(),
-                                             spec_.body_thickness, spec_.body_stiffness, spec_.body_search);
+                                             spec_.body_thickness, spec_.body_stiffness, spec_.body_search,
+                                             c.contact_ramp * spec_.body_thickness);
   body_ = body.get();
   extra.push_back(std::move(body));
   if (spec_.self_collision) {
-    auto self = std::make_unique<SelfCollider>(c.particles(), spec_.self_thickness, spec_.self_stiffness);
+    auto self = std::make_unique<SelfCollider>(c.particles(), spec_.self_thickness, spec_.self_stiffness,
+                                               c.contact_ramp * spec_.self_thickness);
     self_ = self.get();
     extra.push_back(std::move(self));
   }
   cloth_ = std::make_unique<ClothSystem>(c, h, std::move(track), std::move(extra));
-  cloth_->set_exact_spring_adjoint(true);
-  w_.setZero(3 * c.particles());
   body_count_.assign(steps + 1, 0);
   self_count_.assign(steps + 1, 0);
   min_distance_.assign(steps + 1, std::numeric_limits<double>::infinity());
@@ -89,7 +92,13 @@ void CapeSystem::prepare(int n, const VecX& x) {
   if (self_) self_->update(x);
 }
 
-bool CapeSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) {
+void CapeSystem::set_adjoint(AdjointKind kind) {
+  cloth_->set_adjoint(kind);
+  body_->set_curvature(kind == AdjointKind::kExact);
+}
+
+bool CapeSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next,
+                      StepRecord& record) {
   prepare(n, x);
   body_->take_count();
   body_->take_min_distance();
@@ -98,7 +107,7 @@ bool CapeSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& 
     self_->take_count();
     self_->set_counting(true);
   }
-  const bool ok = cloth_->step(n, x, v, u, x_next, v_next);
+  const bool ok = cloth_->step(n, x, v, u, x_next, v_next, record);
   body_->set_counting(false);
   const int nb = body_->take_count();
   const double phi_min = body_->take_min_distance();
@@ -118,14 +127,10 @@ bool CapeSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& 
   return ok;
 }
 
-void CapeSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const VecX& xhat1,
-                              const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) {
+void CapeSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const StepRecord& record,
+                              const VecX& xhat1, const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) {
   prepare(n, x);
-  cloth_->step_adjoint(n, x, v, u, xhat1, vhat1, xhat, vhat, uhat);
-  if (self_) {
-    w_ = uhat / h_;  // the cloth's uhat is h w
-    self_->add_cross_adjoint(w_, h_, xhat);
-  }
+  cloth_->step_adjoint(n, x, v, u, record, xhat1, vhat1, xhat, vhat, uhat);
 }
 
 std::string CapeSystem::describe() const {
@@ -155,7 +160,9 @@ std::vector<std::pair<std::string, double>> CapeSystem::run_stats() const {
 
 std::unique_ptr<System> make_cape_system(const Scene& scene, double h) {
   const int steps = int(std::llround(scene.time.duration() / h));
-  return std::make_unique<CapeSystem>(*scene.cloth, *scene.character, scene.time.fps, steps, h);
+  auto sys = std::make_unique<CapeSystem>(*scene.cloth, *scene.character, scene.time.fps, steps, h);
+  sys->set_adjoint(adjoint_kind(scene.optimizer.adjoint));
+  return sys;
 }
 
 }  // namespace kf

@@ -3,10 +3,8 @@
 // shoulder anchors, pushed out of the moving body mesh and out of itself, inside the step and its adjoint.
 //
 // Step n uses the body posed at animation time animation_time(spec, n h fps) and a spatial hash of x_n.
-// Backward: the cloth's adjoint (body contact through its normal stiffness only, see
-// BodyCollider::set_curvature) plus the self-contact cross blocks of K^T w (SelfCollider::add_cross_adjoint
-// with w = uhat / h). Checked step by step against finite differences: the remaining difference is the
-// integrator-swapping approximation of the cloth (design §4), largest where the pins drive the cloth hard.
+// Backward: the cloth's adjoint with the body and self contacts among its colliders, posed and hashed at
+// the same x_n. The swap adjoint also drops the body contact's curvature (BodyCollider::set_curvature).
 #include <memory>
 #include <vector>
 
@@ -32,9 +30,14 @@ class CapeSystem final : public System {
   // The start run's state when the scene names one (pinned particles moved onto the anchors), else the
   // cloth block's flat layout.
   void initial_state(VecX& x, VecX& v) const override;
-  bool step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) override;
-  void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const VecX& xhat1, const VecX& vhat1,
-                    VecX& xhat, VecX& vhat, VecX& uhat) override;
+  std::unique_ptr<StepRecord> new_record() const override { return cloth_->new_record(); }
+  using System::step;
+  using System::step_adjoint;
+  bool step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next,
+            StepRecord& record) override;
+  void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const StepRecord& record, const VecX& xhat1,
+                    const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) override;
+  void set_adjoint(AdjointKind kind);
   // The cloth's PCG warm start, so checkpointed rollouts recompute cape steps bit for bit.
   void save_step_context(int n, VecX& context) const override { cloth_->save_step_context(n, context); }
   void restore_step_context(int n, const VecX& context) override { cloth_->restore_step_context(n, context); }
@@ -64,7 +67,6 @@ class CapeSystem final : public System {
   BodyCollider* body_ = nullptr;  // owned by cloth_
   SelfCollider* self_ = nullptr;  // owned by cloth_; null when self-collision is off
   std::unique_ptr<ClothSystem> cloth_;
-  VecX w_;
   double cape_length_;
   // Contacts found by step n of the last forward pass (a recomputed step writes the same numbers again).
   std::vector<int> body_count_, self_count_;

@@ -8,8 +8,8 @@
 
 namespace kf {
 
-SelfCollider::SelfCollider(int particles, double thickness, double stiffness)
-    : p_(particles), thickness_(thickness), stiffness_(stiffness), x_(VecX::Zero(3 * particles)), cells_(particles) {}
+SelfCollider::SelfCollider(int particles, double thickness, double stiffness, double ramp)
+    : p_(particles), thickness_(thickness), profile_{stiffness, ramp}, x_(VecX::Zero(3 * particles)), cells_(particles) {}
 
 int64_t SelfCollider::key_of(const Vec3& x, int dx, int dy, int dz) const {
   // 21 bits per axis; wrapping far away only adds candidates that the distance test rejects.
@@ -43,8 +43,10 @@ void SelfCollider::for_each_near(const Vec3& x, Visit&& visit) const {
 Mat3 SelfCollider::pair_jacobian(const Vec3& d, bool definite) const {
   const double r = d.norm();
   const Vec3 n = d / r;
-  Mat3 J = -stiffness_ * n * n.transpose();
-  if (!definite) J += stiffness_ * (thickness_ - r) / r * (Mat3::Identity() - n * n.transpose());
+  double g, dg, ddg;
+  profile_.eval(thickness_ - r, g, dg, ddg);
+  Mat3 J = -dg * n * n.transpose();
+  if (!definite) J += g / r * (Mat3::Identity() - n * n.transpose());
   return J;
 }
 
@@ -54,7 +56,9 @@ bool SelfCollider::contact(int, const Vec3& x, const Vec3&, bool definite, Conta
   Mat3 K = Mat3::Zero();
   for_each_near(x, [&](int, const Vec3& d) {
     const double r = d.norm();
-    f += stiffness_ * (thickness_ - r) / r * d;
+    double g, dg, ddg;
+    profile_.eval(thickness_ - r, g, dg, ddg);
+    f += g / r * d;
     K += pair_jacobian(d, definite);
     ++found;
   });
@@ -66,12 +70,37 @@ bool SelfCollider::contact(int, const Vec3& x, const Vec3&, bool definite, Conta
   return true;
 }
 
-void SelfCollider::add_cross_adjoint(const VecX& w, double h, VecX& xhat) const {
+Vec3 SelfCollider::pair_stiffness_derivative(const Vec3& d, const Vec3& w, const Vec3& c) const {
+  // w . Jd c = -g'(thickness - r) (w.n)(c.n), n = d / r; dr/dd = n, dn/dd = (I - n n^T) / r.
+  const double r = d.norm();
+  const Vec3 n = d / r;
+  double g, dg, ddg;
+  profile_.eval(thickness_ - r, g, dg, ddg);
+  const double wn = w.dot(n), cn = c.dot(n);
+  return ddg * wn * cn * n - dg / r * (cn * (w - wn * n) + wn * (c - cn * n));
+}
+
+void SelfCollider::add_definite_stiffness_derivative(int, const VecX&, const VecX& w, const VecX& c, double scale,
+                                                     VecX& out) const {
+  // Pair (i, j) puts -g' n n^T in particle i's diagonal block, a function of d = x_i - x_j; particle i
+  // gathers the derivative of its own term (+) and of its partners' terms (-), so each writes only itself.
+  tbb::parallel_for(tbb::blocked_range<int>(0, p_, 128), [&](const tbb::blocked_range<int>& r) {
+    for (int i = r.begin(); i < r.end(); ++i) {
+      Vec3 acc = Vec3::Zero();
+      for_each_near(seg(x_, i), [&](int j, const Vec3& d) {
+        acc += pair_stiffness_derivative(d, seg(w, i), seg(c, i)) - pair_stiffness_derivative(-d, seg(w, j), seg(c, j));
+      });
+      seg(out, i) += scale * acc;
+    }
+  });
+}
+
+void SelfCollider::add_cross_transpose(int, const VecX& w, double scale, VecX& out) const {
   tbb::parallel_for(tbb::blocked_range<int>(0, p_, 128), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i) {
       Vec3 acc = Vec3::Zero();
       for_each_near(seg(x_, i), [&](int j, const Vec3& d) { acc -= pair_jacobian(d, false) * seg(w, j); });
-      seg(xhat, i) += h * acc;
+      seg(out, i) += scale * acc;
     }
   });
 }

@@ -1,11 +1,11 @@
 #pragma once
-// Cloth self-collision: particle pairs closer than `thickness` repel with a spring k (thickness - r) along
-// the line between them (energy ½k(thickness - r)^2), found through a spatial hash rebuilt per state.
+// Cloth self-collision: particle pairs closer than `thickness` repel with g(thickness - r) along the line
+// between them (ContactProfile g), found through a spatial hash rebuilt per state.
 //
 // It fits the per-particle Collider interface as a gather: the contact of particle i sums its pairs and
 // gives d f_i / d x_i. The cross blocks d f_i / d x_j (= -d f_i / d x_i of that pair) cannot go through
-// that interface; the cloth's implicit matrix A leaves them out in both passes (like a block-Jacobi
-// stiffness), and add_cross_adjoint puts them into the adjoint's K^T w so xhat uses the exact Jacobian.
+// that interface; the cloth's implicit matrix A leaves them out (like a block-Jacobi stiffness), and
+// add_cross_transpose puts them into the adjoints' Kx^T w so xhat uses the exact Jacobian.
 #include <atomic>
 #include <cstdint>
 #include <utility>
@@ -17,23 +17,29 @@ namespace kf {
 
 class SelfCollider final : public Collider {
  public:
-  // particles: p; thickness: metres; stiffness: N/m.
-  SelfCollider(int particles, double thickness, double stiffness);
+  // particles: p; thickness, ramp: metres; stiffness: N/m.
+  SelfCollider(int particles, double thickness, double stiffness, double ramp);
 
   // Positions of the state the next contact() calls see (3p, metres). Allocation-free.
   void update(const VecX& x);
 
   // Sums the pairs of the particle at x (it must be one of the updated positions; the particle itself is
-  // recognised by its identical position). df/dx: per pair -k n n^T, plus k (thickness - r)/r (I - n n^T)
-  // unless `definite`.
+  // recognised by its identical position). df/dx: per pair -g' n n^T, plus g/r (I - n n^T) unless
+  // `definite`.
   bool contact(int n, const Vec3& x, const Vec3& v, bool definite, ContactForce& out) const override;
-
-  // xhat_i += h * sum_j (d f_j / d x_i)^T w_j = -h * sum_j J_ij w_j over the pairs of the updated state
-  // (w, xhat: 3p). Parallel per particle i, each writing only its own entries.
-  void add_cross_adjoint(const VecX& w, double h, VecX& xhat) const;
+  // Pairs need both ends: the whole-cloth form below carries the derivative, so this one is zero.
+  Vec3 definite_stiffness_derivative(int, const Vec3&, const Vec3&, const Vec3&) const override { return Vec3::Zero(); }
+  // Over the pairs of the updated state (x is not read); parallel per particle, each writing only itself.
+  void add_definite_stiffness_derivative(int n, const VecX& x, const VecX& w, const VecX& c, double scale,
+                                         VecX& out) const override;
+  // out_i += scale * sum_j (d f_j / d x_i)^T w_j = -scale * sum_j J_ij w_j over the pairs of the updated
+  // state (w, out: 3p). Parallel per particle i, each writing only its own entries.
+  void add_cross_transpose(int n, const VecX& w, double scale, VecX& out) const override;
 
   // Pair Jacobian J = d f_i / d x_i of one pair with offset d = x_i - x_j (|d| < thickness).
   Mat3 pair_jacobian(const Vec3& d, bool definite) const;
+  // d/dd [w . Jd c] of one pair, Jd = pair_jacobian(d, definite = true).
+  Vec3 pair_stiffness_derivative(const Vec3& d, const Vec3& w, const Vec3& c) const;
 
   void set_counting(bool on) { counting_ = on; }
   // Particle contacts counted since the last take (each pair counts twice).
@@ -45,7 +51,8 @@ class SelfCollider final : public Collider {
   void for_each_near(const Vec3& x, Visit&& visit) const;
 
   int p_;
-  double thickness_, stiffness_;
+  double thickness_;
+  ContactProfile profile_;
   VecX x_;
   std::vector<std::pair<int64_t, int>> cells_;  // (cell key, particle), sorted
   bool counting_ = false;

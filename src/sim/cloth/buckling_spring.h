@@ -13,6 +13,10 @@
 
 namespace kf {
 
+// The definite Jacobian fades the transverse stiffness in over strains 0 .. kTransverseRamp (see
+// spring_jacobian).
+inline constexpr double kTransverseRamp = 0.05;
+
 struct BucklingSpring {
   int a = 0, b = 0;          // particle indices
   double rest = 1.0;         // L, metres
@@ -21,18 +25,33 @@ struct BucklingSpring {
   double f_buckle = 0.0;     // buckling load F_b > 0, N (0: linear in compression too)
 };
 
-// Tension T (N, positive pulls the ends together) and its slope dT/ds (N/m, always >= 0) at length s.
-void spring_tension(const BucklingSpring& sp, double s, double& T, double& dT_ds);
+// Tension T (N, positive pulls the ends together), its slope dT/ds (N/m, always >= 0) and curvature
+// d2T/ds2 (N/m^2) at length s.
+void spring_tension(const BucklingSpring& sp, double s, double& T, double& dT_ds, double& d2T_ds2);
+
+// Stored energy (J) at length s = |x_b - x_a|: the integral of T from L to s, >= 0 and 0 only at s = L.
+// Tension: k (s - L)^2 / 2. Compression (e = L - s):
+//     F_b e - F_b^2 / (k - k_p) (1 - exp(-(k - k_p) e / F_b)) + k_p e^2 / 2.
+// A zero-rest-length spring stores k |d|^2 / 2. x: 3p positions, metres.
+double spring_energy(const BucklingSpring& sp, const VecX& x);
 
 // Force on particle a (N); the force on b is its negative. x: 3p positions, metres.
 Vec3 spring_force(const BucklingSpring& sp, const VecX& x);
 
 // B = d(force on a)/d(x_b) (3x3, N/m). The spring's 6x6 stiffness is [[-B, B], [B, -B]] (B symmetric).
-// `definite` drops the compressive part of the transverse term (T < 0), which keeps -K positive
-// semi-definite so the implicit matrix stays SPD; the exact Jacobian is definite = false.
+// `definite` keeps the transverse term T/s only in tension, faded in smoothly over strains
+// 0 .. kTransverseRamp (never negative, so -K is positive semi-definite and the implicit matrix SPD;
+// C1, so the step map has no kink where a spring passes its rest length); the exact Jacobian is
+// definite = false.
 // Springs shorter than 1e-9 L (L > 0) have no direction: force 0 and B = dT/ds I (finite, never NaN).
 // A zero-rest-length spring (L = 0) is the linear spring f_a = k d with B = k I at every length, s = 0
 // included: its axial and transverse stiffnesses are both k, so the direction never enters.
 Mat3 spring_jacobian(const BucklingSpring& sp, const VecX& x, bool definite);
+
+// d/dd [p . B(d) q] with d = x_b - x_a (N/m^2 times the units of p q): the position derivative of the
+// spring's stiffness met by two vectors, which the exact adjoint of a step needs (the step's matrix
+// holds B). `definite` as for spring_jacobian (its transverse term is cut at the rest length, so this is
+// the derivative from the side the spring is on). Zero for degenerate and zero-rest-length springs.
+Vec3 spring_jacobian_derivative(const BucklingSpring& sp, const VecX& x, bool definite, const Vec3& p, const Vec3& q);
 
 }  // namespace kf

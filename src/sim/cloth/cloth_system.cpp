@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -18,6 +19,12 @@ namespace {
 constexpr int kSpringGrain = 1024;
 constexpr int kParticleGrain = 256;
 }  // namespace
+
+AdjointKind adjoint_kind(const std::string& name) {
+  if (name == "exact") return AdjointKind::kExact;
+  if (name == "swap") return AdjointKind::kSwap;
+  throw std::invalid_argument("unknown adjoint \"" + name + "\" (expected exact or swap)");
+}
 
 ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTrack> pins,
                          std::vector<std::unique_ptr<Collider>> extra_colliders)
@@ -79,7 +86,7 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
     incident_start_.push_back(int(incident_.size()));
   }
 
-  colliders_ = make_colliders(spec.colliders);
+  colliders_ = make_colliders(spec.colliders, spec.contact_ramp);
   for (auto& c : extra_colliders) colliders_.push_back(std::move(c));
   free_.assign(p_, 1);
   for (int i : spec.pins) {
@@ -98,6 +105,9 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   kv_.setZero(3 * p_);
   aw_.setZero(3 * p_);
   w_.setZero(3 * p_);
+  c_.setZero(3 * p_);
+  split_x_.resize(spec.max_halvings);
+  split_v_.resize(spec.max_halvings);
   pcg_.resize(p_, spec.cg_preconditioner == "block_jacobi" ? Preconditioner::kBlockJacobi
                                                            : Preconditioner::kIncompleteCholesky);
 }
@@ -114,7 +124,7 @@ void ClothSystem::initial_state(VecX& x, VecX& v) const {
   }
 }
 
-void ClothSystem::assemble(int n, const VecX& x, const VecX& v) {
+void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs) {
   const int ns = int(springs_.size());
   // Each spring writes only its own slots.
   tbb::parallel_for(tbb::blocked_range<int>(0, ns, kSpringGrain), [&](const tbb::blocked_range<int>& r) {
@@ -129,7 +139,7 @@ void ClothSystem::assemble(int n, const VecX& x, const VecX& v) {
     }
   });
   // Each particle gathers its own row in a fixed order.
-  const double h = h_;
+  const double h = hs > 0 ? hs : h_;
   tbb::parallel_for(tbb::blocked_range<int>(0, p_, kParticleGrain), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i) {
       const double m = mass_[i];
@@ -168,31 +178,28 @@ void ClothSystem::assemble(int n, const VecX& x, const VecX& v) {
   pcg_.prepare(A_, free_);
 }
 
-bool ClothSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) {
-  assemble(n, x, v);
-  const double h = h_;
+bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u,
+                              VecX& x_next, VecX& v_next) {
+  const double h = std::ldexp(h_, -depth), t1 = t0 + std::ldexp(1.0, -depth);
+  assemble(n, x, v, h);
   tbb::parallel_for(tbb::blocked_range<int>(0, p_, kParticleGrain), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i)
       seg(rhs_, i) = h * (seg(force_, i) + h * K_.row_times(i, v) + seg(u, i));
   });
-  // Pinned particles go exactly to their track position at n+1.
+  // Pinned particles go exactly to their track position at n + t1 (linear within the step).
   for (int i : pinned_list_) {
-    Vec3 pos, vel;
-    pins_->state(n + 1, i, seg(x0_, i), pos, vel);
-    seg(dv_, i) = (pos - seg(x, i)) / h - seg(v, i);
-  }
-  const bool warm = n == last_forward_n_ + 1;
-  const PcgResult res = pcg_.solve(A_, free_, rhs_, dv_, spec_.cg_tolerance, spec_.cg_max_iterations, warm);
-  last_forward_n_ = res.converged ? n : -2;
-  last_cg_ = res.iterations;
-  if (exact_springs_) {
-    if (n >= int(step_dv_.size())) {
-      step_dv_.resize(n + 1);
-      step_x_.resize(n + 1);
+    Vec3 a, b, vel;
+    pins_->state(n + 1, i, seg(x0_, i), b, vel);
+    if (t1 < 1) {
+      pins_->state(n, i, seg(x0_, i), a, vel);
+      b = (1 - t1) * a + t1 * b;
     }
-    step_dv_[n] = dv_;
-    step_x_[n] = x;
+    seg(dv_, i) = (b - seg(x, i)) / h - seg(v, i);
   }
+  // Substeps start cold, so a split step depends on its inputs only.
+  const bool warm = depth == 0 && n == last_forward_n_ + 1;
+  const PcgResult res = pcg_.solve(A_, free_, rhs_, dv_, spec_.cg_tolerance, spec_.cg_max_iterations, warm);
+  last_cg_ = res.iterations;
   v_next.resize(3 * p_);
   x_next.resize(3 * p_);
   v_next = v + dv_;
@@ -200,30 +207,133 @@ bool ClothSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
   return res.converged && x_next.allFinite() && v_next.allFinite();
 }
 
-void ClothSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const VecX& xhat1,
-                               const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) {
-  assemble(n, x, v);
-  const double h = h_;
+ClothSystem::Energy ClothSystem::energy(int n, const VecX& x, const VecX& v) const {
+  Energy e;
+  for (int i = 0; i < p_; ++i) {
+    for (const auto& c : colliders_) e.contact += c->energy(n, seg(x, i));
+    if (!free_[i]) continue;
+    e.kinetic += 0.5 * mass_[i] * seg(v, i).squaredNorm();
+    e.gravity -= mass_[i] * spec_.gravity.dot(seg(x, i));
+  }
+  for (const BucklingSpring& s : springs_) e.elastic += spring_energy(s, x);
+  return e;
+}
+
+double ClothSystem::external_work(const VecX& u, const VecX& x0, const VecX& x1) const {
+  double w = 0;
+  for (int i = 0; i < p_; ++i)
+    if (free_[i]) w += seg(u, i).dot(seg(x1, i) - seg(x0, i));
+  for (const BucklingSpring& s : springs_) {
+    if (free_[s.a] && free_[s.b]) continue;
+    // A pin does work -f . dx against the elastic force f on its particle (trapezoidal rule).
+    const Vec3 fa = 0.5 * (spring_force(s, x0) + spring_force(s, x1));
+    if (!free_[s.a]) w -= fa.dot(seg(x1, s.a) - seg(x0, s.a));
+    if (!free_[s.b]) w += fa.dot(seg(x1, s.b) - seg(x0, s.b));
+  }
+  return w;
+}
+
+bool ClothSystem::checked_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u,
+                               VecX& x_next, VecX& v_next, ClothRecord& rec) {
+  const bool solved = linear_step(n, depth, t0, x, v, u, x_next, v_next);
+  bool accept = solved;
+  if (depth < spec_.max_halvings) {
+    // Backward Euler with damping never gains energy; the linearised step does when it moves particles
+    // fast across springs or into colliders, and halving the step shrinks what it invents ~4-16 times.
+    const Energy before = energy(n, x, v), after = solved ? energy(n, x_next, v_next) : Energy{};
+    const double work = solved ? external_work(u, x, x_next) : 0.0;
+    // The energy the step moves is the tolerance's scale (a NaN gain fails the test and splits).
+    const double moved = before.kinetic + before.elastic + before.contact + std::abs(work) +
+                         std::abs(after.gravity - before.gravity);
+    accept = solved && after.total() - before.total() - work <= 1e-3 * moved + 1e-12;
+  }
+  if (accept) {
+    if (int(rec.substeps.size()) <= rec.count) rec.substeps.emplace_back();
+    ClothRecord::Substep& e = rec.substeps[rec.count++];
+    e.depth = depth;
+    e.t0 = t0;
+    e.dv = dv_;
+    if (depth > 0) {  // the first substep of an unsplit step starts from the step's own state
+      e.x = x;
+      e.v = v;
+    }
+    return true;
+  }
+  if (depth >= spec_.max_halvings) return false;
+  VecX &xm = split_x_[depth], &vm = split_v_[depth];  // sized for every depth up front: no reallocation here
+  xm.resize(3 * p_);
+  vm.resize(3 * p_);
+  const double half = std::ldexp(1.0, -depth - 1);
+  return checked_step(n, depth + 1, t0, x, v, u, xm, vm, rec) &&
+         checked_step(n, depth + 1, t0 + half, xm, vm, u, x_next, v_next, rec);
+}
+
+bool ClothSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next,
+                       StepRecord& record) {
+  ClothRecord& rec = static_cast<ClothRecord&>(record);
+  rec.count = 0;
+  const bool ok = checked_step(n, 0, 0.0, x, v, u, x_next, v_next, rec);
+  last_substeps_ = rec.count;
+  // The next step starts warm only from an unsplit step's solution.
+  last_forward_n_ = ok && rec.count == 1 ? n : -2;
+  return ok;
+}
+
+void ClothSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX&, const StepRecord& record,
+                               const VecX& xhat1, const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) {
+  const ClothRecord& rec = static_cast<const ClothRecord&>(record);
+  uhat.setZero(3 * p_);
+  if (rec.count == 1) {
+    const ClothRecord::Substep& e = rec.substeps[0];
+    substep_adjoint(n, h_, x, v, e.dv, /*warm=*/true, xhat1, vhat1, xhat, vhat, uhat);
+    return;
+  }
+  // A split step: its substeps walked back in reverse, cold, each from its own start state.
+  adj_x_ = xhat1;
+  adj_v_ = vhat1;
+  for (int k = rec.count - 1; k >= 0; --k) {
+    const ClothRecord::Substep& e = rec.substeps[k];
+    const VecX& xs = k == 0 ? x : e.x;
+    const VecX& vs = k == 0 ? v : e.v;
+    substep_adjoint(n, std::ldexp(h_, -e.depth), xs, vs, e.dv, /*warm=*/false, adj_x_, adj_v_, xhat, vhat, uhat);
+    adj_x_.swap(xhat);
+    adj_v_.swap(vhat);
+  }
+  xhat.swap(adj_x_);
+  vhat.swap(adj_v_);
+  last_adjoint_n_ = -2;
+}
+
+void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v, const VecX& dv, bool warm_ok,
+                                  const VecX& xhat1, const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) {
+  const bool exact = adjoint_ == AdjointKind::kExact;
+  assemble(n, x, v, h);
   rhs_ = vhat1 + h * xhat1;
   // w is zero on pinned particles.
-  const bool warm = n == last_adjoint_n_ - 1;
+  const bool warm = warm_ok && n == last_adjoint_n_ - 1;
   const PcgResult res = pcg_.solve(A_, free_, rhs_, w_, spec_.cg_tolerance, spec_.cg_max_iterations, warm);
   last_adjoint_n_ = res.converged ? n : -2;
   last_adjoint_cg_ = res.iterations;
   const VecX& w = w_;
+  c_ = v + dv;  // v1
   xhat.resize(3 * p_);
   vhat.resize(3 * p_);
-  uhat.resize(3 * p_);
-  // xhat needs K^T w with the exact force derivative (the definite K of A and the missing damping term
-  // would bias every step by O(h), which does not vanish as h falls). Per spring G = d f_a / d x_b
-  // (elastic + damping): (K^T w)_a = G^T (w_b - w_a), (K^T w)_b = -(that).
+  // Per spring, with dw = w_b - w_a and G = d f_a / d x_b (elastic + damping, exact): (Kx^T w)_a = G^T dw,
+  // (Kx^T w)_b = -(that). The exact adjoint adds the derivative of the spring's part of
+  // w^T (h K v1 + D dv) = -dw^T (h B dv1 + B_d ddv) in x_a (its negative in x_b); xhat gets h times the sum.
   const int ns = int(springs_.size());
   tbb::parallel_for(tbb::blocked_range<int>(0, ns, kSpringGrain), [&](const tbb::blocked_range<int>& r) {
     for (int k = r.begin(); k < r.end(); ++k) {
       const BucklingSpring& s = springs_[k];
+      const Vec3 dw = seg(w, s.b) - seg(w, s.a);
       Mat3 G = spring_jacobian(s, x, /*definite=*/false);
       if (k < damped_) G += damping_jacobian_x(s, spec_.damping, x, v);
-      spring_f_[k] = G.transpose() * (seg(w, s.b) - seg(w, s.a));
+      Vec3 t = G.transpose() * dw;
+      if (exact && dw.squaredNorm() > 0) {
+        t += h * spring_jacobian_derivative(s, x, /*definite=*/true, dw, seg(c_, s.b) - seg(c_, s.a));
+        if (k < damped_) t += damping_jacobian_v_derivative(s, spec_.damping, x, dw, seg(dv, s.b) - seg(dv, s.a));
+      }
+      spring_f_[k] = t;
     }
   });
   tbb::parallel_for(tbb::blocked_range<int>(0, p_, kParticleGrain), [&](const tbb::blocked_range<int>& r) {
@@ -238,53 +348,19 @@ void ClothSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& 
         seg(xhat, i) = seg(xhat1, i) + h * kw;
         seg(vhat, i) = mass_[i] * seg(w, i);
       } else {
-        // x_pin enters the free rows through b (h K) and through the prescribed dv (A / h).
+        // x_pin enters the free rows through b (h K) and through the prescribed dv (A / h), and (exact)
+        // its own v1 = (track - x_pin) / h.
         seg(xhat, i) = h * kw + A_.row_times(i, w) / h;
+        if (exact) seg(xhat, i) -= seg(vhat1, i) / h;
         seg(vhat, i).setZero();
       }
     }
   });
-  uhat = h * w;
-  if (exact_springs_ && n < int(step_dv_.size()) && step_x_[n].size() == x.size() && step_x_[n] == x)
-    add_dropped_spring_terms(x, v, step_dv_[n], xhat);
-}
-
-void ClothSystem::add_dropped_spring_terms(const VecX& x, const VecX& v, const VecX& dv, VecX& xhat) {
-  // Per spring, with K_s, D_s its off-diagonal blocks (the diagonal ones are their negatives):
-  // w^T (h^2 K c + h D dv) = -dw^T (h^2 K_s dc + h D_s ddv), dw = w_a - w_b, dc = c_a - c_b, c = v + dv.
-  // K_s, D_s depend on x_b - x_a only, so the gradient in x_b is that in x_a negated.
-  const double h = h_;
-  const VecX& w = w_;
-  xs_ = x;
-  for (int k = 0; k < int(springs_.size()); ++k) {
-    const BucklingSpring& s = springs_[k];
-    const Vec3 dw = seg(w, s.a) - seg(w, s.b);
-    if (dw.squaredNorm() == 0.0) continue;  // both ends pinned
-    const Vec3 ddv = seg(dv, s.a) - seg(dv, s.b), dc = seg(v, s.a) - seg(v, s.b) + ddv;
-    auto g = [&]() {
-      double r = -h * h * dw.dot(spring_jacobian(s, xs_, /*definite=*/true) * dc);
-      if (k < damped_) r -= h * dw.dot(damping_jacobian_v(s, spec_.damping, xs_) * ddv);
-      return r;
-    };
-    const double e = 1e-6 * s.rest, g0 = g();
-    for (int c = 0; c < 3; ++c) {
-      double& xb = xs_[3 * s.b + c];
-      const double x0 = xb;
-      xb = x0 + e;
-      const double gp = g();
-      xb = x0 - e;
-      const double gm = g();
-      xb = x0;
-      // The buckling response's stiffness jumps at the buckling load: a step across it would give the
-      // jump over e. There the two one-sided differences disagree; the smaller one is the smooth side.
-      const double up = (gp - g0) / e, down = (g0 - gm) / e;
-      const double d = std::abs(up - down) <= 0.1 * (std::abs(up) + std::abs(down)) + 1e-12
-                           ? (gp - gm) / (2 * e)
-                           : (std::abs(up) < std::abs(down) ? up : down);
-      xhat[3 * s.b + c] += d;
-      xhat[3 * s.a + c] -= d;
-    }
+  for (const auto& col : colliders_) {
+    col->add_cross_transpose(n, w, h, xhat);
+    if (exact) col->add_definite_stiffness_derivative(n, x, w, c_, h * h, xhat);
   }
+  uhat += h * w;
 }
 
 void ClothSystem::save_step_context(int n, VecX& context) const {
@@ -305,12 +381,14 @@ std::string ClothSystem::describe() const {
   std::ostringstream os;
   os << "cloth: " << spec_.nx << "x" << spec_.ny << " particles, " << springs_.size() << " springs, "
      << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, PCG ("
-     << spec_.cg_preconditioner << ")";
+     << spec_.cg_preconditioner << "), " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
   return os.str();
 }
 
 std::unique_ptr<System> make_cloth_system(const Scene& scene, double h) {
-  return std::make_unique<ClothSystem>(*scene.cloth, h);
+  auto sys = std::make_unique<ClothSystem>(*scene.cloth, h);
+  sys->set_adjoint(adjoint_kind(scene.optimizer.adjoint));
+  return sys;
 }
 
 }  // namespace kf

@@ -1,19 +1,31 @@
 #pragma once
-// Choi-Ko cloth stepped by linearised backward Euler (design §4), with its approximate adjoint.
+// Choi-Ko cloth stepped by linearised backward Euler (design §4), with two adjoints.
 //
 // Forward:  A dv = b, A = M - h D - h^2 K, b = h (f + h K v + u), solved by PCG (IC(0)) with pinned
-//           particles filtered out (Baraff-Witkin); v1 = v + dv, x1 = x + h v1.
-// Backward: A^T w = vhat1 + h xhat1 on the free set, vhat = M w, xhat = xhat1 + h K^T w, uhat = h w.
-// In A (both passes) K is the springs' definite stiffness (compressive transverse part dropped) plus the
-// colliders' normal stiffness, D the spring damping and air drag; the non-symmetric position derivative
-// of spring damping is left out of A in both passes, so A is symmetric and the backward solve reuses the
-// forward PCG. The K^T w of xhat is not a solve: it uses the exact df/dx (springs, damping, collider
-// curvature), since any bias there is O(h) per step and would not shrink as h falls.
-// A is recomputed at (x_n, v_n) in the backward pass rather than stored.
+//           particles filtered out (Baraff-Witkin); v1 = v + dv, x1 = x + h v1. K is the springs'
+//           definite stiffness (compressive transverse part dropped) plus the colliders' normal
+//           stiffness, D the spring damping and air drag (the non-symmetric position derivative of spring
+//           damping is left out, so A is symmetric and the backward solve reuses the forward PCG).
+//           A pinned particle moves to its PinTrack position at n+1 whatever its state.
+// Both adjoints solve A w = vhat1 + h xhat1 on the free set (w = 0 on pins), then uhat = h w,
+// vhat = M w (0 on pins) and xhat = xhat1 + h Kx^T w + ..., Kx the exact df/dx (springs, spring damping,
+// collider curvature, self-contact cross blocks: any bias there is O(h) per step).
+//   exact: the transpose of the Jacobian of the step as implemented. It adds the position derivative of
+//          the step's matrix met by the step's velocity change, h^2 d/dx[w^T K(x) v1] + h d/dx[w^T D(x) dv]
+//          (per spring and contact, analytically: spring_jacobian_derivative, damping_jacobian_v_derivative,
+//          Collider::add_definite_stiffness_derivative), with dv from the step's record, and on pinned
+//          rows (A w - vhat1)/h, since a pin's v1 = (track - x)/h.
+//   swap:  the paper's integrator-swapping approximation: those terms are dropped (and pinned rows keep
+//          only A w / h). O(h) per step away from the exact one.
+// Steps that gain energy are split (the linearised step invents energy when particles move fast across
+// springs or into colliders, and stiff sheets at one step per frame then blow up): a step whose energy
+// after, less the work of the controls and the pins, exceeds its energy before by more than 1e-3 of the
+// energy it moves is replaced by two half steps, each checked the same way, down to h / 2^max_halvings
+// (pins move linearly within a step). The accepted substeps are the step's record; both adjoints walk
+// them back, and never decide again, so the exact adjoint stays the Jacobian of the step taken.
+// A is recomputed at each substep's start in the backward pass rather than stored.
 // PCG starts from the previous step's solution when steps come in sequence (n after n-1 forward, n after
 // n+1 backward) and from zero otherwise, so a rollout is the same function of its inputs on every run.
-// A pinned particle is moved to its PinTrack position at n+1 whatever its state, so no adjoint flows
-// through its own x, v (vhat = 0 there); only its coupling to free neighbours reaches xhat.
 #include <memory>
 #include <vector>
 
@@ -27,6 +39,22 @@
 
 namespace kf {
 
+enum class AdjointKind { kExact, kSwap };
+// "exact" | "swap" (scene key optimizer.adjoint, --adjoint); throws std::invalid_argument on others.
+AdjointKind adjoint_kind(const std::string& name);
+
+// What a cloth step records for its adjoint: its accepted substeps in order, each with its depth (length
+// h / 2^depth), start state (the step's own for the first one) and velocity change (3p, pins included).
+struct ClothRecord final : StepRecord {
+  struct Substep {
+    int depth = 0;
+    double t0 = 0;  // start, as a fraction of the step
+    VecX x, v, dv;
+  };
+  std::vector<Substep> substeps;  // entries [0, count) are this step's; the rest are kept for reuse
+  int count = 0;
+};
+
 class ClothSystem final : public System {
  public:
   // h: step length, s. `pins` defaults to StaticPins. `extra_colliders` act after the spec's colliders
@@ -38,23 +66,26 @@ class ClothSystem final : public System {
   double h() const override { return h_; }
   const VecX& masses() const override { return mass_; }
   void initial_state(VecX& x, VecX& v) const override;
-  bool step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) override;
-  void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const VecX& xhat1, const VecX& vhat1,
-                    VecX& xhat, VecX& vhat, VecX& uhat) override;
+  std::unique_ptr<StepRecord> new_record() const override { return std::make_unique<ClothRecord>(); }
+  using System::step;
+  using System::step_adjoint;
+  bool step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next,
+            StepRecord& record) override;
+  void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const StepRecord& record, const VecX& xhat1,
+                    const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) override;
   std::string describe() const override;
   // The PCG warm start of step n (the solution of step n-1 when that was the last forward solve).
   void save_step_context(int n, VecX& context) const override;
   void restore_step_context(int n, const VecX& context) override;
 
-  // Opt-in (off by default): the adjoint also carries the spring terms the integrator swap drops,
-  // d/dx of w^T [h^2 K(x) v_{n+1} + h D(x) dv] (K, D the springs' blocks of A), the position derivative of
-  // the implicit matrix met by the step's velocity change. Central differences of each spring's 3x3
-  // blocks give it; the forward pass keeps every step's dv for it. Where the pins drive the cloth hard
-  // (a cape on a moving body) the dropped terms dominate the adjoint's error.
-  void set_exact_spring_adjoint(bool on) { exact_springs_ = on; }
+  void set_adjoint(AdjointKind kind) { adjoint_ = kind; }
+  AdjointKind adjoint() const { return adjoint_; }
+  // The colliders (the spec's, then the extra ones), for systems that update them per step.
+  const std::vector<std::unique_ptr<Collider>>& collider_list() const { return colliders_; }
 
-  // Evaluates forces f and the blocks of K, D and A at (x, v) of step n (the forward pass does this).
-  void assemble(int n, const VecX& x, const VecX& v);
+  // Evaluates forces f and the blocks of K, D and A at (x, v) of step n for a (sub)step of length hs
+  // (default h; the forward pass does this).
+  void assemble(int n, const VecX& x, const VecX& v, double hs = 0);
   // Results of the last assemble: f (3p, N), K (N/m), D (N s/m), A (kg), as Eigen matrices (allocate).
   const VecX& force() const { return force_; }
   SpMat stiffness_matrix() const { return K_.to_sparse(); }
@@ -66,18 +97,38 @@ class ClothSystem final : public System {
   int damped_springs() const { return damped_; }
   int colliders() const { return int(colliders_.size()); }
   bool pinned(int i) const { return !free_[i]; }
+  // Substeps of the last forward step (1 when it was not split).
+  int last_substeps() const { return last_substeps_; }
+  // Energy (J) of a state at step n: free particles' kinetic and gravitational energy, every spring's,
+  // and the contact energy of the colliders that report it (Collider::energy).
+  struct Energy {
+    double kinetic = 0, gravity = 0, elastic = 0, contact = 0;
+    double total() const { return kinetic + gravity + elastic + contact; }
+  };
+  Energy energy(int n, const VecX& x, const VecX& v) const;
   // PCG iterations of the last forward / backward solve (benchmarks, logs).
   int last_cg_iterations() const { return last_cg_; }
   int last_adjoint_cg_iterations() const { return last_adjoint_cg_; }
 
  private:
+  // One linearised step of length h / 2^depth from fraction t0 of step n; the pins go to their position at
+  // fraction t0 + 2^-depth. dv_ holds its velocity change.
+  bool linear_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u, VecX& x_next,
+                   VecX& v_next);
+  // Takes the (sub)step and, if it gains energy, its two halves instead; appends accepted ones to `rec`.
+  bool checked_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u, VecX& x_next,
+                    VecX& v_next, ClothRecord& rec);
+  // The adjoint of one linearised substep (see the header comment); adds its uhat to `uhat`.
+  void substep_adjoint(int n, double hs, const VecX& x, const VecX& v, const VecX& dv, bool warm, const VecX& xhat1,
+                       const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat);
+  // Work (J) of the control u on the free particles and of the pins on their springs from x0 to x1.
+  double external_work(const VecX& u, const VecX& x0, const VecX& x1) const;
+
   struct Incident {
     int spring;  // index into springs_
     int sign;    // +1 when this particle is the spring's `a` end, -1 when it is `b`
     int slot;    // block (this particle, other end) in the row
   };
-
-  void add_dropped_spring_terms(const VecX& x, const VecX& v, const VecX& dv, VecX& xhat);
 
   ClothSpec spec_;
   int p_;
@@ -99,10 +150,12 @@ class ClothSystem final : public System {
   VecX force_, rhs_, dv_, kv_, aw_;
   FilteredPcg pcg_;
   int last_cg_ = 0, last_adjoint_cg_ = 0;
-  VecX w_;                                       // last adjoint solution (warm start)
-  bool exact_springs_ = false;
-  std::vector<VecX> step_dv_, step_x_;  // per step: dv and the x it was taken from (exact spring adjoint)
-  VecX xs_;                             // scratch positions for the spring differences
+  VecX w_;   // last adjoint solution (warm start)
+  std::vector<VecX> split_x_, split_v_;  // per depth: the state between two halves of a split step
+  VecX adj_x_, adj_v_, adj_u_;           // adjoint of one substep (walking split steps back)
+  int last_substeps_ = 0;
+  VecX c_;   // v + dv of the step being walked back
+  AdjointKind adjoint_ = AdjointKind::kExact;
   int last_forward_n_ = -2, last_adjoint_n_ = -2;  // steps of the last solves, -2: none
 };
 

@@ -2,8 +2,19 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 namespace kf {
+
+void Collider::add_definite_stiffness_derivative(int n, const VecX& x, const VecX& w, const VecX& c, double scale,
+                                                 VecX& out) const {
+  const int p = int(x.size() / 3);
+  tbb::parallel_for(tbb::blocked_range<int>(0, p, 256), [&](const tbb::blocked_range<int>& r) {
+    for (int i = r.begin(); i < r.end(); ++i)
+      seg(out, i) += scale * definite_stiffness_derivative(n, seg(x, i), seg(w, i), seg(c, i));
+  });
+}
 
 bool DistanceCollider::contact(int, const Vec3& x, const Vec3&, bool definite, ContactForce& out) const {
   double phi;
@@ -11,16 +22,38 @@ bool DistanceCollider::contact(int, const Vec3& x, const Vec3&, bool definite, C
   Mat3 dn;
   distance(x, phi, n, dn);
   if (phi >= thickness_) return false;
-  const double depth = thickness_ - phi;
-  out.f = stiffness_ * depth * n;
-  out.dfdx = -stiffness_ * n * n.transpose();
-  if (!definite) out.dfdx += stiffness_ * depth * dn;
+  double g, dg, ddg;
+  profile_.eval(thickness_ - phi, g, dg, ddg);
+  out.f = g * n;
+  out.dfdx = -dg * n * n.transpose();
+  if (!definite) out.dfdx += g * dn;
   out.dfdv.setZero();
   return true;
 }
 
-GroundCollider::GroundCollider(const ColliderSpec& s)
-    : DistanceCollider(s.thickness, s.stiffness), point_(s.center), normal_(s.axis.normalized()) {}
+double DistanceCollider::energy(int, const Vec3& x) const {
+  double phi;
+  Vec3 n;
+  Mat3 dn;
+  distance(x, phi, n, dn);
+  return profile_.energy(thickness_ - phi);
+}
+
+Vec3 DistanceCollider::definite_stiffness_derivative(int, const Vec3& x, const Vec3& w, const Vec3& c) const {
+  double phi;
+  Vec3 n;
+  Mat3 dn;
+  distance(x, phi, n, dn);
+  if (phi >= thickness_) return Vec3::Zero();
+  double g, dg, ddg;
+  profile_.eval(thickness_ - phi, g, dg, ddg);
+  // w . Kd c = -g'(thickness - phi) (w.n)(c.n); d(thickness - phi)/dx = -n, d(w.n)/dx = dn^T w.
+  const double wn = w.dot(n), cn = c.dot(n);
+  return ddg * wn * cn * n - dg * (cn * (dn.transpose() * w) + wn * (dn.transpose() * c));
+}
+
+GroundCollider::GroundCollider(const ColliderSpec& s, double ramp)
+    : DistanceCollider(s.thickness, s.stiffness, ramp), point_(s.center), normal_(s.axis.normalized()) {}
 
 void GroundCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const {
   phi = normal_.dot(x - point_);
@@ -28,8 +61,8 @@ void GroundCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dn
   dnormal_dx.setZero();
 }
 
-SphereCollider::SphereCollider(const ColliderSpec& s)
-    : DistanceCollider(s.thickness, s.stiffness), center_(s.center), radius_(s.radius) {}
+SphereCollider::SphereCollider(const ColliderSpec& s, double ramp)
+    : DistanceCollider(s.thickness, s.stiffness, ramp), center_(s.center), radius_(s.radius) {}
 
 void SphereCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const {
   const Vec3 d = x - center_;
@@ -45,8 +78,8 @@ void SphereCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dn
   dnormal_dx = (Mat3::Identity() - normal * normal.transpose()) / r;
 }
 
-TorusCollider::TorusCollider(const ColliderSpec& s)
-    : DistanceCollider(s.thickness, s.stiffness),
+TorusCollider::TorusCollider(const ColliderSpec& s, double ramp)
+    : DistanceCollider(s.thickness, s.stiffness, ramp),
       center_(s.center),
       axis_(s.axis.normalized()),
       major_(s.radius),
@@ -82,12 +115,13 @@ void TorusCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dno
   dnormal_dx = (Mat3::Identity() - normal * normal.transpose()) / d * dw;
 }
 
-std::vector<std::unique_ptr<Collider>> make_colliders(const std::vector<ColliderSpec>& specs) {
+std::vector<std::unique_ptr<Collider>> make_colliders(const std::vector<ColliderSpec>& specs, double ramp_fraction) {
   std::vector<std::unique_ptr<Collider>> out;
   for (const ColliderSpec& s : specs) {
-    if (s.type == "ground") out.push_back(std::make_unique<GroundCollider>(s));
-    else if (s.type == "sphere") out.push_back(std::make_unique<SphereCollider>(s));
-    else if (s.type == "torus") out.push_back(std::make_unique<TorusCollider>(s));
+    const double ramp = ramp_fraction * s.thickness;
+    if (s.type == "ground") out.push_back(std::make_unique<GroundCollider>(s, ramp));
+    else if (s.type == "sphere") out.push_back(std::make_unique<SphereCollider>(s, ramp));
+    else if (s.type == "torus") out.push_back(std::make_unique<TorusCollider>(s, ramp));
     else throw std::invalid_argument("unknown collider type \"" + s.type + "\"");
   }
   return out;

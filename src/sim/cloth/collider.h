@@ -2,13 +2,19 @@
 // Colliders push cloth particles out with stiff springs that switch on within a thickness of the surface.
 //
 // A collider acts on one particle at a time, so a moving character mesh (closest point per particle) fits
-// the same interface as one more collider. The force of a collider with signed distance phi(x) (outside
-// positive) and outward unit normal n(x) is f = k (thickness - phi) n when phi < thickness, else 0.
+// the same interface as one more collider; pair contacts (self-collision) add their cross couplings
+// through the whole-cloth methods. The force of a collider with signed distance phi(x) (outside positive)
+// and outward unit normal n(x) is f = g(thickness - phi) n, g the ContactProfile (0 outside).
+//
+// Jacobians: the exact df/dx = -g' n n^T + g dn/dx; the definite one (what the implicit matrix holds)
+// keeps -g' n n^T. The exact adjoint also needs the position derivative of that definite block met by
+// two vectors (definite_stiffness_derivative).
 #include <memory>
 #include <vector>
 
 #include "core/types.h"
 #include "scene/cloth_spec.h"
+#include "sim/cloth/contact_profile.h"
 
 namespace kf {
 
@@ -26,23 +32,40 @@ class Collider {
   // implicit matrix (-k n n^T), dropping curvature terms that could make it indefinite; the exact
   // Jacobian is definite = false.
   virtual bool contact(int n, const Vec3& x, const Vec3& v, bool definite, ContactForce& out) const = 0;
+  // Energy (J) the contact of a particle at x stores at step n, 0 outside contact. Colliders that move
+  // by themselves (a character's body) or act on pairs report 0: the step's energy check cannot account
+  // for the work they do.
+  virtual double energy(int /*n*/, const Vec3& /*x*/) const { return 0.0; }
+  // d/dx [w . Kd(x) c], Kd the definite df/dx of the particle at x (zero out of contact).
+  virtual Vec3 definite_stiffness_derivative(int n, const Vec3& x, const Vec3& w, const Vec3& c) const = 0;
+
+  // Whole-cloth forms for the adjoint (x, w, c, out: 3p). add_definite_stiffness_derivative adds
+  // scale * d/dx [w^T Kd(x) c]; the default sums the per-particle derivative (parallel over particles).
+  virtual void add_definite_stiffness_derivative(int n, const VecX& x, const VecX& w, const VecX& c, double scale,
+                                                 VecX& out) const;
+  // Adds scale * C^T w, C the blocks of the exact df/dx that couple two particles (none by default).
+  virtual void add_cross_transpose(int /*n*/, const VecX& /*w*/, double /*scale*/, VecX& /*out*/) const {}
 };
 
 // A signed-distance collider: the three analytic shapes only supply phi, n and dn/dx.
 class DistanceCollider : public Collider {
  public:
-  DistanceCollider(double thickness, double stiffness) : thickness_(thickness), stiffness_(stiffness) {}
+  // ramp: the width of the contact profile's stiffness ramp, metres (0: linear penalty).
+  DistanceCollider(double thickness, double stiffness, double ramp) : thickness_(thickness), profile_{stiffness, ramp} {}
   bool contact(int n, const Vec3& x, const Vec3& v, bool definite, ContactForce& out) const override;
+  Vec3 definite_stiffness_derivative(int n, const Vec3& x, const Vec3& w, const Vec3& c) const override;
+  double energy(int n, const Vec3& x) const override;
   // Signed distance phi (m), outward unit normal n and dn/dx (3x3, 1/m) at x.
   virtual void distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const = 0;
 
  private:
-  double thickness_, stiffness_;
+  double thickness_;
+  ContactProfile profile_;
 };
 
 class GroundCollider final : public DistanceCollider {
  public:
-  GroundCollider(const ColliderSpec& s);
+  GroundCollider(const ColliderSpec& s, double ramp);
   void distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const override;
 
  private:
@@ -51,7 +74,7 @@ class GroundCollider final : public DistanceCollider {
 
 class SphereCollider final : public DistanceCollider {
  public:
-  SphereCollider(const ColliderSpec& s);
+  SphereCollider(const ColliderSpec& s, double ramp);
   void distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const override;
 
  private:
@@ -62,7 +85,7 @@ class SphereCollider final : public DistanceCollider {
 // The ring of the ring toss: a torus with major radius R around `axis` and tube radius r.
 class TorusCollider final : public DistanceCollider {
  public:
-  TorusCollider(const ColliderSpec& s);
+  TorusCollider(const ColliderSpec& s, double ramp);
   void distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const override;
 
  private:
@@ -70,7 +93,8 @@ class TorusCollider final : public DistanceCollider {
   double major_, tube_;
 };
 
-// One collider per spec entry, in order (empty for a scene without colliders).
-std::vector<std::unique_ptr<Collider>> make_colliders(const std::vector<ColliderSpec>& specs);
+// One collider per spec entry, in order (empty for a scene without colliders). ramp_fraction: each
+// contact profile's ramp as a fraction of its collider's thickness.
+std::vector<std::unique_ptr<Collider>> make_colliders(const std::vector<ColliderSpec>& specs, double ramp_fraction);
 
 }  // namespace kf

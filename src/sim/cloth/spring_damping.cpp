@@ -32,4 +32,13 @@ Mat3 damping_jacobian_x(const BucklingSpring& sp, double c, const VecX& x, const
   return c * (n * (P * dv).transpose() + n.dot(dv) * P);
 }
 
+Vec3 damping_jacobian_v_derivative(const BucklingSpring& sp, double c, const VecX& x, const Vec3& p, const Vec3& q) {
+  const Vec3 d = seg(x, sp.b) - seg(x, sp.a);
+  const double s = d.norm();
+  if (s <= kDegenerate * sp.rest) return Vec3::Zero();
+  const Vec3 n = d / s;
+  const double pn = p.dot(n), qn = q.dot(n);
+  return c * (qn * (p - pn * n) + pn * (q - qn * n)) / s;
+}
+
 }  // namespace kf

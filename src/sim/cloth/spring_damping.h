@@ -14,8 +14,11 @@ Vec3 damping_force(const BucklingSpring& sp, double c, const VecX& x, const VecX
 // d(force on a)/d(v_b) = c n n^T (3x3, N s/m, symmetric); d/d(v_a) is its negative.
 Mat3 damping_jacobian_v(const BucklingSpring& sp, double c, const VecX& x);
 
-// d(force on a)/d(x_b) (3x3, N/m, not symmetric); d/d(x_a) is its negative. The cloth system leaves this
-// out of K in both the forward and the adjoint pass (as Baraff & Witkin do); it is here for completeness.
+// d(force on a)/d(x_b) (3x3, N/m, not symmetric); d/d(x_a) is its negative. The implicit matrix leaves
+// it out (as Baraff & Witkin do, keeping the matrix symmetric); the adjoints use it in their exact df/dx.
 Mat3 damping_jacobian_x(const BucklingSpring& sp, double c, const VecX& x, const VecX& v);
+
+// d/dd [p . (c n n^T) q], d = x_b - x_a: the position derivative of damping_jacobian_v met by p and q.
+Vec3 damping_jacobian_v_derivative(const BucklingSpring& sp, double c, const VecX& x, const Vec3& p, const Vec3& q);
 
 }  // namespace kf

@@ -13,12 +13,6 @@
 
 namespace kf {
 
-namespace {
-// Records hold ~(4 + neighbours) numbers per agent and step; beyond this many agent-steps the adjoint
-// recomputes its neighbour search instead.
-constexpr long kMaxRecordedAgentSteps = 4'000'000;
-}  // namespace
-
 FlockSystem::FlockSystem(const FlockSpec& spec, double h, int steps, unsigned seed, double h_ref)
     : spec_(spec), h_(h), seed_(seed), masses_(VecX::Constant(spec.agents, spec.mass)), neighbor_forces_(spec) {
   if (spec.wander.strength > 0) {
@@ -26,7 +20,6 @@ FlockSystem::FlockSystem(const FlockSpec& spec, double h, int steps, unsigned se
     local_forces_.push_back(std::make_unique<WanderForce>(w, spec.agents, steps));
   }
   if (spec.drag.strength > 0) local_forces_.push_back(std::make_unique<DragForce>(spec.drag.strength));
-  if (long(steps) * spec.agents <= kMaxRecordedAgentSteps) cached_steps_ = std::max(steps, 0);
   y_.resize(dof());
 }
 
@@ -42,19 +35,12 @@ void FlockSystem::check_size(const VecX& x, const VecX& v) const {
                                 std::to_string(dof()));
 }
 
-FlockSystem::StepRecord& FlockSystem::record_for(int n) {
-  if (n < 0 || n >= cached_steps_) return scratch_;
-  if (records_.size() < size_t(cached_steps_)) records_.resize(cached_steps_);
-  return records_[n];
-}
-
-void FlockSystem::search(StepRecord& r, const VecX& x, bool with_centering) {
+void FlockSystem::search(FlockRecord& r, const VecX& x, bool with_centering) {
   const int p = spec_.agents;
   if (r.offset.size() != dof()) {
     r.offset.resize(dof());
     r.b.resize(p);
   }
-  r.x = x;
   if (!neighbor_forces_.any()) {
     r.offset.setZero();
     std::fill(r.b.begin(), r.b.end(), 1.0);
@@ -78,10 +64,11 @@ Vec3 FlockSystem::local_force(int n, const VecX& v, int i) const {
   return f;
 }
 
-bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) {
+bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next,
+                       StepRecord& record) {
   check_size(x, v);
-  StepRecord& r = record_for(n);
-  search(r, x, false);
+  FlockRecord& r = static_cast<FlockRecord&>(record);
+  search(r, x, false);  // the step fills the centering quantities itself
   x_next.resize(dof());
   v_next.resize(dof());
   parallel_agents(spec_.agents, [&](int i) {
@@ -101,7 +88,7 @@ bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
   return x_next.allFinite() && v_next.allFinite();
 }
 
-void FlockSystem::transpose_apply(const StepRecord& r, int n, const VecX& x, const VecX& v, const VecX& y, int j,
+void FlockSystem::transpose_apply(const FlockRecord& r, int n, const VecX& x, const VecX& v, const VecX& y, int j,
                                   Vec3& kt, Vec3& dt) const {
   kt.setZero();
   dt.setZero();
@@ -110,11 +97,10 @@ void FlockSystem::transpose_apply(const StepRecord& r, int n, const VecX& x, con
   if (spec_.drag.strength > 0) dt -= spec_.drag.strength * seg(y, j);
 }
 
-void FlockSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const VecX& xhat1,
-                               const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) {
+void FlockSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX&, const StepRecord& record,
+                               const VecX& xhat1, const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) {
   check_size(x, v);
-  StepRecord& r = record_for(n);
-  if (r.x.size() != x.size() || r.x != x) search(r, x, true);  // not the state the forward step saw
+  const FlockRecord& r = static_cast<const FlockRecord&>(record);
   const int p = spec_.agents;
   // The step writes y = 0 whatever its inputs, so the y parts of xhat1 and vhat1 flow nowhere.
   parallel_agents(p, [&](int i) {

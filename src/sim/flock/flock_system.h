@@ -5,9 +5,8 @@
 //   s = vhat1 + h xhat1,  xhat = xhat1 + h K^T M^-1 s,  vhat = s + h D^T M^-1 s,  uhat = h M^-1 s
 // with K = df/dx, D = df/dv at (x_n, v_n) applied matrix-free. The three neighbour forces run fused in one
 // pass over each agent's list (NeighborForces); wander and drag are per-agent terms.
-// The forward step records, per step, the neighbour lists and centering means it found; the adjoint step
-// at the same step reuses them when its x is bit-identical to the recorded one (as in a rollout's
-// backward pass), so one adjoint step costs one transposed pass and no neighbour search.
+// The forward step records the neighbour lists and centering means it found (FlockRecord, the step's tape
+// entry); its adjoint reads them, so one adjoint step costs one transposed pass and no neighbour search.
 // Planar: the y components of x1, v1 and of every adjoint output are exactly zero (y of u is ignored).
 #include <memory>
 #include <vector>
@@ -20,6 +19,13 @@
 
 namespace kf {
 
+// What a flock step found at its state: neighbours and centering quantities (offset 3p, b p).
+struct FlockRecord final : StepRecord {
+  NeighborGrid grid;
+  VecX offset;
+  std::vector<double> b;
+};
+
 class FlockSystem final : public System {
  public:
   // h: step (s); steps: how many steps the wander table covers (later steps are computed on demand);
@@ -31,9 +37,13 @@ class FlockSystem final : public System {
   const VecX& masses() const override { return masses_; }
   void initial_state(VecX& x, VecX& v) const override;
   bool planar() const override { return true; }
-  bool step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next) override;
-  void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const VecX& xhat1, const VecX& vhat1,
-                    VecX& xhat, VecX& vhat, VecX& uhat) override;
+  std::unique_ptr<StepRecord> new_record() const override { return std::make_unique<FlockRecord>(); }
+  using System::step;
+  using System::step_adjoint;
+  bool step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next,
+            StepRecord& record) override;
+  void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const StepRecord& record, const VecX& xhat1,
+                    const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) override;
   std::string describe() const override;
 
   // The pieces of a step, exposed for derivative checks. All vectors 3p.
@@ -43,20 +53,11 @@ class FlockSystem final : public System {
   void apply_KT_DT(int n, const VecX& x, const VecX& v, const VecX& y, VecX& KTy, VecX& DTy);
 
  private:
-  // What the forward step found at one state: neighbours and centering quantities (offset 3p, b p).
-  struct StepRecord {
-    VecX x;  // the positions it belongs to (empty: none)
-    NeighborGrid grid;
-    VecX offset;
-    std::vector<double> b;
-  };
-  // The record for step n (a scratch one for steps beyond the cached range).
-  StepRecord& record_for(int n);
   // Fills `r` for x: neighbour search, and the centering quantities when `with_centering`.
-  void search(StepRecord& r, const VecX& x, bool with_centering);
+  void search(FlockRecord& r, const VecX& x, bool with_centering);
   void check_size(const VecX& x, const VecX& v) const;
   // (K^T y)_j and (D^T y)_j of all forces at the state of record r.
-  void transpose_apply(const StepRecord& r, int n, const VecX& x, const VecX& v, const VecX& y, int j, Vec3& kt,
+  void transpose_apply(const FlockRecord& r, int n, const VecX& x, const VecX& v, const VecX& y, int j, Vec3& kt,
                        Vec3& dt) const;
   Vec3 local_force(int n, const VecX& v, int i) const;  // wander + drag on agent i
 
@@ -66,9 +67,7 @@ class FlockSystem final : public System {
   VecX masses_;
   NeighborForces neighbor_forces_;
   std::vector<std::unique_ptr<FlockForce>> local_forces_;  // per-agent terms: wander, drag
-  std::vector<StepRecord> records_;
-  int cached_steps_ = 0;
-  StepRecord scratch_;
+  FlockRecord scratch_;  // forces() and apply_KT_DT
   VecX y_;  // M^-1 s in the adjoint step
 };
 
