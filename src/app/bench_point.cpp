@@ -47,7 +47,7 @@ BenchPoint measure_point(const Scene& scene, const BenchPointOptions& o) {
   p.diverged = problem.last_diverged();
   p.keyframe_initial = keyframe_terms(problem);
   if (o.gradcheck_samples > 0 && !p.diverged) {
-    const GradcheckResult c = gradcheck(problem, z0, o.gradcheck_samples, o.gradcheck_eps, 7);
+    const GradcheckResult c = gradcheck(problem, z0, {.samples = o.gradcheck_samples, .eps = o.gradcheck_eps});
     p.grad_cosine = c.cosine;
     p.grad_rel_error = c.rel_error_norm;
   }

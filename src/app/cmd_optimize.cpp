@@ -16,6 +16,10 @@ void add_optimize_options(CLI::App* sub, OptimizeOptions& o) {
                   "override the scene's optimizer.checkpoint_every: keep every k-th state for the adjoint pass "
                   "and recompute the rest (0 = keep all states)")
       ->check(CLI::Range(0, 10000000));
+  sub->add_option("--adjoint", o.adjoint,
+                  "override the scene's optimizer.adjoint for cloth: exact (the transpose of the step's own "
+                  "Jacobian) or swap (the paper's integrator-swapping approximation)")
+      ->check(CLI::IsMember({"exact", "swap"}));
   sub->add_flag("--quiet", o.quiet, "no line per evaluation, only a progress display");
 }
 

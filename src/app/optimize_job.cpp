@@ -77,7 +77,8 @@ void write_history_csv(const fs::path& path, const std::vector<HistoryRow>& rows
 
 OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& opt) {
   const bool resuming = !opt.resume.empty();
-  const Scene scene = resuming ? load_run_scene(opt.resume) : load_scene(scene_file);
+  Scene scene = resuming ? load_run_scene(opt.resume) : load_scene(scene_file);
+  if (!opt.adjoint.empty()) scene.optimizer.adjoint = opt.adjoint;
   const fs::path dir = resuming ? fs::path(opt.resume) : run_dir_for(scene, opt.out);
 
   // The stages of coarse-to-fine continuation; a resumed run continues in the last stage.
@@ -204,6 +205,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
                            {"steps", time.steps()},
                            {"substeps", time.substeps},
                            {"checkpoint_every", problem->checkpoint_every()},
+                           {"adjoint", scene.optimizer.adjoint},
                            {"stages", stages.size()},
                            {"resumed", resuming},
                            {"status", status},

@@ -11,6 +11,7 @@ struct OptimizeOptions {
   bool quiet = false;         // no per-evaluation lines on stdout
   std::string resume;         // run directory to continue from (its scene.json and controls.bin)
   int checkpoint_every = -1;  // override the scene's optimizer.checkpoint_every when >= 0
+  std::string adjoint;        // override the scene's optimizer.adjoint when not empty ("exact" | "swap")
 };
 
 struct OptimizeOutcome {

@@ -145,7 +145,7 @@ GradcheckResult check_gradient(const Scene& scene, double perturb, int samples) 
   std::mt19937_64 rng(11);
   std::normal_distribution<double> normal(0.0, perturb);
   for (int i = 0; i < z.size(); ++i) z[i] += normal(rng);
-  return gradcheck(problem, z, samples, 0.1, 5);
+  return gradcheck(problem, z, {.samples = samples, .eps = 0.1, .kink_tolerance = 1e300, .seed = 5});
 }
 
 class FigureSceneGradient : public ::testing::TestWithParam<std::string> {};

@@ -33,7 +33,7 @@ TEST_P(ProblemGradient, AdjointMatchesFiniteDifferences) {
   test::ToySystem sys(4, scene.time.h());
   Problem problem(scene, scene.time, sys);
   VecX z = problem.initial_guess() + 0.3 * VecX::Random(problem.size());
-  const GradcheckResult r = gradcheck(problem, z, 60, 1e-3, 3);
+  const GradcheckResult r = gradcheck(problem, z, {.samples = 60, .eps = 1e-3, .seed = 3});
   ASSERT_GT(r.grad_norm, 1e-3);  // not trivially zero
   EXPECT_GE(r.checked, std::min(11, problem.size()));  // the rigid throw has only six
   EXPECT_LT(r.max_rel_error, 1e-6) << "cosine " << r.cosine;

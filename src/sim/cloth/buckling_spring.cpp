@@ -29,30 +29,72 @@ void transverse_stiffness(const BucklingSpring& sp, double s, double T, double d
 }
 }  // namespace
 
+namespace {
+
+// The Choi-Ko compression law at compression e > 0 and its first two derivatives in e (not s).
+struct Compression {
+  double T, T_e, T_ee;
+};
+Compression choi_ko(const BucklingSpring& sp, double e) {
+  const double soft = sp.k - sp.k_post, a = soft / sp.f_buckle, decay = std::exp(-a * e);
+  return {-(sp.f_buckle * (1.0 - decay) + sp.k_post * e), -(soft * decay + sp.k_post), soft * a * decay};
+}
+
+// Energy of the Choi-Ko law alone from 0 to e (J); -expm1 keeps the small-e end accurate.
+double choi_ko_energy(const BucklingSpring& sp, double e) {
+  const double soft = sp.k - sp.k_post;
+  return sp.f_buckle * e + sp.f_buckle * sp.f_buckle / soft * std::expm1(-soft * e / sp.f_buckle) +
+         0.5 * sp.k_post * e * e;
+}
+
+// Compressions below e0 blend the linear law -k e into Choi-Ko's with a quintic smoothstep.
+double blend_end(const BucklingSpring& sp) { return kBuckleBlend * sp.f_buckle / (sp.k - sp.k_post); }
+
+Compression blended(const BucklingSpring& sp, double e) {
+  const double e0 = blend_end(sp);
+  const Compression c = choi_ko(sp, e);
+  if (e >= e0) return c;
+  const double u = e / e0;
+  const double w = u * u * u * (10 - 15 * u + 6 * u * u), w_e = 30 * u * u * (1 - u) * (1 - u) / e0,
+               w_ee = 60 * u * (1 - u) * (1 - 2 * u) / (e0 * e0);
+  const double d = c.T + sp.k * e, d_e = c.T_e + sp.k, d_ee = c.T_ee;  // Choi-Ko less the linear law
+  return {-sp.k * e + w * d, -sp.k + w_e * d + w * d_e, w_ee * d + 2 * w_e * d_e + w * d_ee};
+}
+
+bool buckles(const BucklingSpring& sp) { return sp.f_buckle > 0 && sp.k > sp.k_post; }
+
+}  // namespace
+
 void spring_tension(const BucklingSpring& sp, double s, double& T, double& dT_ds, double& d2T_ds2) {
   const double e = sp.rest - s;
-  if (e <= 0 || sp.f_buckle <= 0) {
+  if (e <= 0 || !buckles(sp)) {
     T = -sp.k * e;
     dT_ds = sp.k;
     d2T_ds2 = 0;
     return;
   }
-  const double soft = sp.k - sp.k_post;
-  const double decay = std::exp(-soft * e / sp.f_buckle);
-  T = -(sp.f_buckle * (1.0 - decay) + sp.k_post * e);
-  dT_ds = soft * decay + sp.k_post;
-  d2T_ds2 = soft * soft / sp.f_buckle * decay;
+  const Compression c = blended(sp, e);
+  T = c.T;
+  dT_ds = -c.T_e;  // ds = -de
+  d2T_ds2 = c.T_ee;
 }
 
 double spring_energy(const BucklingSpring& sp, const VecX& x) {
   const Vec3 d = seg(x, sp.b) - seg(x, sp.a);
   if (sp.rest == 0) return 0.5 * sp.k * d.squaredNorm();
   const double e = sp.rest - d.norm();
-  const double soft = sp.k - sp.k_post;
-  if (e <= 0 || sp.f_buckle <= 0 || soft <= 0) return 0.5 * sp.k * e * e;
-  // -expm1 keeps the small-e end accurate (there the energy is k e^2 / 2 to leading order).
-  return sp.f_buckle * e + sp.f_buckle * sp.f_buckle / soft * std::expm1(-soft * e / sp.f_buckle) +
-         0.5 * sp.k_post * e * e;
+  if (e <= 0 || !buckles(sp)) return 0.5 * sp.k * e * e;
+  // E(e) = -integral of T from 0 to e: Gauss-Legendre (8 points) over the blend, closed form beyond.
+  static constexpr double kNode[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
+                                      0.9602898564975363};
+  static constexpr double kWeight[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
+                                        0.1012285362903763};
+  const double e0 = blend_end(sp), b = std::min(e, e0), half = 0.5 * b;
+  double energy = 0;
+  for (int k = 0; k < 4; ++k)
+    energy -= half * kWeight[k] * (blended(sp, half * (1 + kNode[k])).T + blended(sp, half * (1 - kNode[k])).T);
+  if (e > e0) energy += choi_ko_energy(sp, e) - choi_ko_energy(sp, e0);
+  return energy;
 }
 
 Vec3 spring_force(const BucklingSpring& sp, const VecX& x) {

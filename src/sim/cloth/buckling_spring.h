@@ -5,13 +5,20 @@
 // s = |d|: the force on a is T d/s, on b its opposite. In tension (s >= L) T = k (s - L). In compression a
 // cloth strip does not resist like a rod: it buckles. After Choi & Ko the compressive force rises to about
 // the Euler buckling load F_b and then grows only slowly (post-buckling stiffness k_p):
-//     T(s) = -( F_b (1 - exp(-(k - k_p) e / F_b)) + k_p e ),   e = L - s > 0,
-// which is C1 at s = L (slope k on both sides) so finite differences and the optimiser see no kink.
+//     T(s) = -( F_b (1 - exp(-(k - k_p) e / F_b)) + k_p e ),   e = L - s > 0.
+// That law meets the linear one at s = L with the same slope but not the same curvature, and the step's
+// matrix holds the slope: every spring crossing its rest length would put a kink into the step map. So for
+// e below e0 = kBuckleBlend F_b / (k - k_p) the linear law -k e blends into Choi-Ko's with a quintic
+// smoothstep, which makes T C2 in s (force, stiffness and its slope continuous everywhere).
 // Type-1 springs (structural, shear) and type-2 springs (bending: across two edges) share this law with
 // their own k; F_b = k L buckle_strain and k_p = buckle_stiffness k.
 #include "core/types.h"
 
 namespace kf {
+
+// The compression over which the linear law blends into the buckling response, as a fraction of the
+// response's own length scale F_b / (k - k_p).
+inline constexpr double kBuckleBlend = 0.5;
 
 // The definite Jacobian fades the transverse stiffness in over strains 0 .. kTransverseRamp (see
 // spring_jacobian).
@@ -30,8 +37,7 @@ struct BucklingSpring {
 void spring_tension(const BucklingSpring& sp, double s, double& T, double& dT_ds, double& d2T_ds2);
 
 // Stored energy (J) at length s = |x_b - x_a|: the integral of T from L to s, >= 0 and 0 only at s = L.
-// Tension: k (s - L)^2 / 2. Compression (e = L - s):
-//     F_b e - F_b^2 / (k - k_p) (1 - exp(-(k - k_p) e / F_b)) + k_p e^2 / 2.
+// Tension: k (s - L)^2 / 2; compression: by quadrature over the blend, in closed form beyond.
 // A zero-rest-length spring stores k |d|^2 / 2. x: 3p positions, metres.
 double spring_energy(const BucklingSpring& sp, const VecX& x);
 
