@@ -55,7 +55,7 @@ BenchPoint measure_point(const Scene& scene, const BenchPointOptions& o) {
   if (o.optimize_evaluations > 0 && !p.diverged) {
     OptimizerSpec spec = scene.optimizer;
     spec.max_evaluations = o.optimize_evaluations;
-    spec.max_seconds = 0;
+    spec.max_seconds = o.optimize_seconds;
     const auto t0 = std::chrono::steady_clock::now();
     const OptimizeResult r = minimize(problem, spec, z0);
     p.optimize_s = seconds_since(t0);

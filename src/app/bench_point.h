@@ -14,6 +14,7 @@ struct BenchPointOptions {
   int gradcheck_samples = 0;    // 0: no finite-difference check
   double gradcheck_eps = 1e-5;  // relative finite-difference step
   int optimize_evaluations = 0; // 0: no optimisation
+  double optimize_seconds = 0;  // > 0: the optimisation also stops after this wall time
   int repeats = 1;              // timings are the fastest of this many runs
 };
 

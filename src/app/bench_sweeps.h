@@ -26,6 +26,19 @@ struct MemorySweepOptions {
   int checkpoint_every = 50, resolution = 16;
 };
 
+struct AdjointSweepOptions {
+  std::filesystem::path scene_dir = "scenes";
+  std::vector<std::string> scenes{"arch", "shapes", "ring-toss", "cape-blend"};
+  int frames = 0;                 // > 0: scenes shortened to this many frames
+  double optimize_seconds = 60;   // wall time each adjoint's optimisation gets
+  int samples = 16;               // finite-difference coordinates per gradient check
+};
+
+// Adjoint: exact against swap on the cloth figures (adjoint.csv): gradient cost and error, and the
+// keyframe error reached in the same wall time. Scenes that cannot load (a cape blend whose clips were not
+// simulated) are skipped with a message.
+nlohmann::json bench_adjoint(const AdjointSweepOptions& o, const std::filesystem::path& out);
+
 // Cloth: time step, resolution, PCG tolerance, per-step vs per-frame control.
 nlohmann::json bench_cloth(const ClothSweepOptions& o, const std::filesystem::path& out);
 // Flock: agents against time per gradient and per short optimisation, with fitted exponents.

@@ -15,7 +15,8 @@ void add_bench_command(CLI::App& app) {
       "bench",
       "sweep speed against error: cloth (time step, resolution, PCG tolerance, per-step vs per-frame control), "
       "flock (agents, fitted scaling exponent), memory (peak RSS against steps with and without adjoint "
-      "checkpointing); writes CSV + PNG under --out");
+      "checkpointing), adjoint (exact against swap on the cloth figures: gradient cost and error, keyframe error "
+      "in the same wall time); writes CSV + PNG under --out");
   struct Options {
     std::string out = "out/bench";
     std::vector<std::string> only;
@@ -23,6 +24,7 @@ void add_bench_command(CLI::App& app) {
     ClothSweepOptions cloth;
     FlockSweepOptions flock;
     MemorySweepOptions memory;
+    AdjointSweepOptions adjoint;
     int point_steps = 0, point_every = 0, point_resolution = 16;
   };
   auto o = std::make_shared<Options>();
@@ -31,7 +33,7 @@ void add_bench_command(CLI::App& app) {
                 "reduced sweep (a few minutes): substeps 1,4,16; n 16,24,32; tolerances 1e-4,1e-6,1e-8; agents "
                 "100,300,1000; steps 500..4000; fewer samples and evaluations. Options given explicitly win.");
   sub->add_option("--only", o->only, "run only these sweeps")
-      ->check(CLI::IsMember({"cloth", "flock", "memory"}))
+      ->check(CLI::IsMember({"cloth", "flock", "memory", "adjoint"}))
       ->delimiter(',');
   auto* c = sub->add_option_group("cloth sweep");
   c->add_option("--substeps", o->cloth.substeps, "steps per 1/30 s frame (h = 1/(30 x substeps))")
@@ -64,6 +66,14 @@ void add_bench_command(CLI::App& app) {
       ->capture_default_str()->check(CLI::Range(1, 10000000));
   m->add_option("--memory-resolution", o->memory.resolution, "n of the n x n cloth")
       ->capture_default_str()->check(CLI::Range(2, 1024));
+  auto* a = sub->add_option_group("adjoint sweep");
+  a->add_option("--adjoint-scenes", o->adjoint.scenes, "cloth scenes (names in --scene-dir) compared exact vs swap")
+      ->capture_default_str()->delimiter(',');
+  a->add_option("--scene-dir", o->adjoint.scene_dir, "where the adjoint sweep's scenes are")->capture_default_str();
+  a->add_option("--adjoint-frames", o->adjoint.frames, "shorten those scenes to this many frames (0: as they are)")
+      ->capture_default_str()->check(CLI::Range(0, 100000));
+  a->add_option("--adjoint-seconds", o->adjoint.optimize_seconds, "wall time of each optimisation")
+      ->capture_default_str()->check(CLI::Range(0.1, 1e6));
   // The child side of the memory sweep: one gradient in a fresh process.
   auto* hidden = sub->add_option_group("");
   hidden->add_option("--memory-point", o->point_steps);
@@ -85,6 +95,8 @@ void add_bench_command(CLI::App& app) {
       if (!given("--flock-frames")) o->flock.frames = 20;
       if (!given("--flock-evaluations")) o->flock.optimize_evaluations = 6;
       if (!given("--steps")) o->memory.steps = {500, 1000, 2000, 4000};
+      if (!given("--adjoint-frames")) o->adjoint.frames = 6;
+      if (!given("--adjoint-seconds")) o->adjoint.optimize_seconds = 10;
     }
     auto want = [&](const std::string& s) {
       return o->only.empty() || std::find(o->only.begin(), o->only.end(), s) != o->only.end();
@@ -95,6 +107,7 @@ void add_bench_command(CLI::App& app) {
     if (want("memory")) summary["memory"] = bench_memory(o->memory, out, std::filesystem::read_symlink("/proc/self/exe"));
     if (want("flock")) summary["flock"] = bench_flock(o->flock, out);
     if (want("cloth")) summary["cloth"] = bench_cloth(o->cloth, out);
+    if (want("adjoint")) summary["adjoint"] = bench_adjoint(o->adjoint, out);
     write_file_atomic(out / "summary.json", summary.dump(2) + "\n");
   });
 }
