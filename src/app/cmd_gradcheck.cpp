@@ -22,7 +22,8 @@ void add_gradcheck_command(CLI::App& app) {
   struct Options {
     std::string scene;
     int samples = 40, frames = 0, substeps = 0;
-    double eps = 1e-4, dt = 0, perturb = 0.1, kink_tolerance = 1e-2, cg_tolerance = 1e-13;
+    double eps = 1e-4, dt = 0, perturb = 0.1, kink_tolerance = 1e-2;
+    std::string solver = "direct";
     unsigned seed = 7;
     std::string adjoint;
   };
@@ -36,10 +37,11 @@ void add_gradcheck_command(CLI::App& app) {
                   "relative disagreement of the differences beyond which a sample is a kink")
       ->check(CLI::Range(0.0, 1e300))
       ->capture_default_str();
-  sub->add_option("--cg-tolerance", o->cg_tolerance,
-                  "cloth: the linear solves' relative residual during the check (the differences of a loosely "
-                  "solved step measure the solver, not the adjoint); 0 keeps the scene's cloth.cg_tolerance")
-      ->check(CLI::Range(0.0, 1e-1))
+  sub->add_option("--solver", o->solver,
+                  "cloth: the steps' linear solve during the check: direct (exact to round-off: differences of "
+                  "an iteratively solved step jitter with its convergence test and measure the solver, not the "
+                  "adjoint) or scene (the scene's cloth.solver and cg_tolerance)")
+      ->check(CLI::IsMember({"direct", "scene"}))
       ->capture_default_str();
   sub->add_option("--frames", o->frames, "shorten the scene to this many frames (keyframes move proportionally)")
       ->check(CLI::Range(1, 1000000));
@@ -61,10 +63,7 @@ void add_gradcheck_command(CLI::App& app) {
     }
     if (o->substeps > 0) scene.time.substeps = o->substeps;
     if (!o->adjoint.empty()) scene.optimizer.adjoint = o->adjoint;
-    if (scene.cloth && o->cg_tolerance > 0) {
-      scene.cloth->cg_tolerance = o->cg_tolerance;
-      scene.cloth->cg_max_iterations = std::max(scene.cloth->cg_max_iterations, 20000);
-    }
+    if (scene.cloth && o->solver == "direct") scene.cloth->solver = "direct";
     if (o->dt > 0) {
       const double n = 1.0 / (scene.time.fps * o->dt);
       if (std::abs(n - std::round(n)) > 1e-6 || std::round(n) < 1)
@@ -87,7 +86,7 @@ void add_gradcheck_command(CLI::App& app) {
     j["control_variables"] = problem.size();
     if (scene.cloth) {
       j["adjoint"] = scene.optimizer.adjoint;
-      j["cg_tolerance"] = scene.cloth->cg_tolerance;
+      j["solver"] = scene.cloth->solver;
     }
     std::cout << j.dump() << "\n";
   });

@@ -42,6 +42,7 @@ struct ClothSpec {
   double cg_tolerance = 1e-8;           // PCG stops when |r| <= cg_tolerance * |b| (filtered)
   int cg_max_iterations = 1000;         // PCG failing to converge within this fails the step
   std::string cg_preconditioner = "incomplete_cholesky";  // or "block_jacobi"
+  std::string solver = "pcg";           // "direct": sparse LDL^T per step, exact to round-off
   // A step that gains energy is split in halves, at most this many times (0: never split).
   int max_halvings = 8;
   // Every contact's stiffness rises from 0 to full over this fraction of its thickness (ContactProfile);

@@ -181,3 +181,27 @@ TEST(ClothSystem, BitIdenticalForOneAndTwoThreads) {
 
 }  // namespace
 }  // namespace kf
+
+namespace kf {
+namespace {
+
+TEST(ClothSystem, DirectSolveTakesThePcgStepToRoundOff) {
+  const std::string text = R"({"nx": 7, "ny": 5, "pins": "top_corners", "velocity": [0.3, 0, 0.5],
+                               "cg_tolerance": 1e-13, "cg_max_iterations": 20000)";
+  ClothSpec iterative = spec_from(text + "}"), direct = spec_from(text + R"(, "solver": "direct"})");
+  ClothSystem a(iterative, 1.0 / 60), b(direct, 1.0 / 60);
+  VecX x, v, xa(3 * 35), va(3 * 35), xb(3 * 35), vb(3 * 35);
+  a.initial_state(x, v);
+  const VecX u = VecX::Constant(3 * 35, 0.01);
+  for (int n = 0; n < 20; ++n) {
+    ASSERT_TRUE(a.step(n, x, v, u, xa, va));
+    ASSERT_TRUE(b.step(n, x, v, u, xb, vb));
+    EXPECT_LT((va - vb).norm(), 1e-10 * va.norm()) << "step " << n;
+    x = xa;
+    v = va;
+  }
+  EXPECT_NE(b.describe().find("LDL"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace kf

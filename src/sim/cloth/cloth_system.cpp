@@ -106,6 +106,7 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   aw_.setZero(3 * p_);
   w_.setZero(3 * p_);
   c_.setZero(3 * p_);
+  direct_solve_ = spec.solver == "direct";
   split_x_.resize(spec.max_halvings);
   split_v_.resize(spec.max_halvings);
   pcg_.resize(p_, spec.cg_preconditioner == "block_jacobi" ? Preconditioner::kBlockJacobi
@@ -175,7 +176,8 @@ void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs) {
       A_.block(d) += m * Mat3::Identity();
     }
   });
-  pcg_.prepare(A_, free_);
+  if (direct_solve_) direct_ok_ = direct_.factor(A_, free_);
+  else pcg_.prepare(A_, free_);
 }
 
 bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u,
@@ -198,7 +200,7 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
   }
   // Substeps start cold, so a split step depends on its inputs only.
   const bool warm = depth == 0 && n == last_forward_n_ + 1;
-  const PcgResult res = pcg_.solve(A_, free_, rhs_, dv_, spec_.cg_tolerance, spec_.cg_max_iterations, warm);
+  const PcgResult res = solve(rhs_, dv_, warm);
   last_cg_ = res.iterations;
   v_next.resize(3 * p_);
   x_next.resize(3 * p_);
@@ -217,6 +219,13 @@ ClothSystem::Energy ClothSystem::energy(int n, const VecX& x, const VecX& v) con
   }
   for (const BucklingSpring& s : springs_) e.elastic += spring_energy(s, x);
   return e;
+}
+
+PcgResult ClothSystem::solve(const VecX& b, VecX& x, bool warm) {
+  if (!direct_solve_) return pcg_.solve(A_, free_, b, x, spec_.cg_tolerance, spec_.cg_max_iterations, warm);
+  PcgResult r;
+  r.converged = direct_ok_ && direct_.solve(A_, free_, b, x);
+  return r;
 }
 
 double ClothSystem::external_work(const VecX& u, const VecX& x0, const VecX& x1) const {
@@ -311,7 +320,7 @@ void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v,
   rhs_ = vhat1 + h * xhat1;
   // w is zero on pinned particles.
   const bool warm = warm_ok && n == last_adjoint_n_ - 1;
-  const PcgResult res = pcg_.solve(A_, free_, rhs_, w_, spec_.cg_tolerance, spec_.cg_max_iterations, warm);
+  const PcgResult res = solve(rhs_, w_, warm);
   last_adjoint_n_ = res.converged ? n : -2;
   last_adjoint_cg_ = res.iterations;
   const VecX& w = w_;
@@ -380,8 +389,8 @@ void ClothSystem::restore_step_context(int n, const VecX& context) {
 std::string ClothSystem::describe() const {
   std::ostringstream os;
   os << "cloth: " << spec_.nx << "x" << spec_.ny << " particles, " << springs_.size() << " springs, "
-     << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, PCG ("
-     << spec_.cg_preconditioner << "), " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
+     << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, "
+     << (direct_solve_ ? "sparse LDL^T" : "PCG (" + spec_.cg_preconditioner + ")") << ", " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
   return os.str();
 }
 

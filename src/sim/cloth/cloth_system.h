@@ -33,6 +33,7 @@
 #include "sim/cloth/block_sparse.h"
 #include "sim/cloth/buckling_spring.h"
 #include "sim/cloth/collider.h"
+#include "sim/cloth/direct_solve.h"
 #include "sim/cloth/filtered_pcg.h"
 #include "sim/cloth/pin_track.h"
 #include "sim/system.h"
@@ -121,6 +122,8 @@ class ClothSystem final : public System {
   // The adjoint of one linearised substep (see the header comment); adds its uhat to `uhat`.
   void substep_adjoint(int n, double hs, const VecX& x, const VecX& v, const VecX& dv, bool warm, const VecX& xhat1,
                        const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat);
+  // Solves the assembled A on the free set (x: prescribed values on pins, warm start on free ones).
+  PcgResult solve(const VecX& b, VecX& x, bool warm);
   // Work (J) of the control u on the free particles and of the pins on their springs from x0 to x1.
   double external_work(const VecX& u, const VecX& x0, const VecX& x1) const;
 
@@ -149,6 +152,8 @@ class ClothSystem final : public System {
   BlockSparse3 K_, D_, A_;
   VecX force_, rhs_, dv_, kv_, aw_;
   FilteredPcg pcg_;
+  FilteredDirect direct_;  // cloth.solver = "direct"
+  bool direct_solve_ = false, direct_ok_ = false;
   int last_cg_ = 0, last_adjoint_cg_ = 0;
   VecX w_;   // last adjoint solution (warm start)
   std::vector<VecX> split_x_, split_v_;  // per depth: the state between two halves of a split step
