@@ -4,6 +4,7 @@ writes one CSV row per run (the JSON the command prints, flattened).
 
 Usage: scripts/gradcheck_table.py OUT.csv --scenes A.json[,B.json] [--frames 3[,10]] [--dt 1/30[,1/60]]
                                   [--perturb 0[,0.01]] [--adjoint exact[,swap]] [--samples N] [--eps E]
+                                  [--solver direct|scene]
 Regenerates the gradient tables of the README (see its "Accuracy of the gradients")."""
 import argparse, csv, itertools, json, os, subprocess, sys
 from fractions import Fraction
@@ -19,6 +20,7 @@ p.add_argument("--perturb", default="0,0.01,0.1")
 p.add_argument("--adjoint", default="exact")
 p.add_argument("--samples", default="20")
 p.add_argument("--eps", default="1e-4")
+p.add_argument("--solver", default="direct", help="direct, or scene (the scene's own PCG and tolerance)")
 a = p.parse_args()
 split = lambda s: [x for x in s.split(",") if x]
 columns = ["scene", "frames", "dt", "perturb", "adjoint", "steps", "h", "checked", "kinks", "max_rel_error",
@@ -27,7 +29,7 @@ rows = []
 for scene, frames, dt, perturb, adjoint in itertools.product(split(a.scenes), split(a.frames), split(a.dt),
                                                              split(a.perturb), split(a.adjoint)):
     cmd = [keyframe, "gradcheck", scene, "--perturb", perturb, "--adjoint", adjoint, "--samples", a.samples,
-           "--eps", a.eps]
+           "--eps", a.eps, "--solver", a.solver]
     if int(frames) > 0:
         cmd += ["--frames", frames]
     if dt != "0":
