@@ -80,9 +80,9 @@ TEST(CapeFigure, BlendEndsFarCloserToClipBThanTheUncontrolledCape) {
   std::printf("%s after %d evaluations (%s)\n", m.dump().c_str(), res.evaluations, res.status.c_str());
   const double before = m["uncontrolled"]["rms_position_error"], after = m["controlled"]["rms_position_error"];
   EXPECT_GT(before, 0.005) << "the clips end too close together for the check to mean anything";
-  // The exact adjoint gets to 0.30 of the uncontrolled error within 80 evaluations and stays there to 160
-  // (the swap adjoint to 0.89).
-  EXPECT_LT(after, 0.35 * before);
+  // Within 80 evaluations the exact adjoint gets to 0.59 of the uncontrolled error and the swap adjoint
+  // to 0.64; both stay there to 200 (the effort and velocity terms hold the blend's optimum).
+  EXPECT_LT(after, 0.7 * before);
   EXPECT_LT(m["controlled"]["rms_position_error_percent"].get<double>(), 2.0);
   EXPECT_GT(sys->run_stats()[0].second, 0) << "the cape never touched the body";
 }
