@@ -17,15 +17,6 @@ namespace kf {
 
 namespace {
 
-// The scene cut to `frames` frames (0: as it is), keyframes moved proportionally.
-Scene shortened(Scene scene, int frames) {
-  if (frames <= 0 || frames >= scene.time.frames) return scene;
-  const double scale = double(frames) / scene.time.frames;
-  for (auto& obj : scene.objectives) obj.frame = std::max(1, int(std::lround(obj.frame * scale)));
-  scene.time.frames = frames;
-  return scene;
-}
-
 // The gradient against finite differences at the scene's initial controls perturbed by 0.01 (at zero
 // controls a sheet at rest takes steps with no velocity change, where the two adjoints coincide), with the
 // linear solves tightened so the differences measure the adjoint and not the solver.

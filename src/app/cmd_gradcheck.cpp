@@ -55,12 +55,7 @@ void add_gradcheck_command(CLI::App& app) {
                                            "integrator swap); default: the scene's optimizer.adjoint")
       ->check(CLI::IsMember({"exact", "swap"}));
   sub->callback([o] {
-    Scene scene = load_scene(o->scene);
-    if (o->frames > 0 && o->frames < scene.time.frames) {
-      const double scale = double(o->frames) / scene.time.frames;
-      for (auto& obj : scene.objectives) obj.frame = std::max(1, int(std::lround(obj.frame * scale)));
-      scene.time.frames = o->frames;
-    }
+    Scene scene = shortened(load_scene(o->scene), o->frames);
     if (o->substeps > 0) scene.time.substeps = o->substeps;
     if (!o->adjoint.empty()) scene.optimizer.adjoint = o->adjoint;
     if (scene.cloth && o->solver == "direct") scene.cloth->solver = "direct";

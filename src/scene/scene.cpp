@@ -1,5 +1,7 @@
 #include "scene/scene.h"
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -130,6 +132,14 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& file) {
   }
   root.finish();
   return s;
+}
+
+Scene shortened(Scene scene, int frames) {
+  if (frames <= 0 || frames >= scene.time.frames) return scene;
+  const double scale = double(frames) / scene.time.frames;
+  for (auto& obj : scene.objectives) obj.frame = std::max(1, int(std::lround(obj.frame * scale)));
+  scene.time.frames = frames;
+  return scene;
 }
 
 Scene load_scene(const std::filesystem::path& file) {

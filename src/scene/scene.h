@@ -35,4 +35,8 @@ Scene load_scene(const std::filesystem::path& file);
 // The same from JSON text already in memory (used by tests and the fuzzer); `file` names it in messages.
 Scene parse_scene(const std::string& text, const std::filesystem::path& file);
 
+// The scene cut to its first `frames` frames (unchanged when frames <= 0 or not fewer than it has), its
+// keyframes moved proportionally (gradient checks and benchmarks of long scenes).
+Scene shortened(Scene scene, int frames);
+
 }  // namespace kf

@@ -130,14 +130,6 @@ TEST(FlockFigures, RaceReduced) {
   EXPECT_LT(std::abs(o.measures[1]["error"].get<double>()), 0.3);  // the flock kept its straight path
 }
 
-// The scene cut to `frames` frames, keyframes moved proportionally (as `keyframe gradcheck --frames`).
-Scene shortened(Scene scene, int frames) {
-  const double scale = double(frames) / scene.time.frames;
-  for (auto& obj : scene.objectives) obj.frame = std::max(1, int(std::lround(obj.frame * scale)));
-  scene.time.frames = frames;
-  return scene;
-}
-
 GradcheckResult check_gradient(const Scene& scene, double perturb, int samples) {
   auto sys = make_system(scene, scene.time.h());
   Problem problem(scene, scene.time, *sys);

@@ -81,8 +81,6 @@ class ClothSystem final : public System {
 
   void set_adjoint(AdjointKind kind) { adjoint_ = kind; }
   AdjointKind adjoint() const { return adjoint_; }
-  // The colliders (the spec's, then the extra ones), for systems that update them per step.
-  const std::vector<std::unique_ptr<Collider>>& collider_list() const { return colliders_; }
 
   // Evaluates forces f and the blocks of K, D and A at (x, v) of step n for a (sub)step of length hs
   // (default h; the forward pass does this).
