@@ -59,13 +59,13 @@ class KeyframeTerm : public ObjectiveTerm {
   double eval(const VecX& x, const VecX& v, VecX& gx, VecX& gv) const override {
     const VecX& q = on_velocity_ ? v : x;
     VecX& g = on_velocity_ ? gv : gx;
-    double val = 0;
+    long double val = 0;  // extended: round-off in φ sets the floor of a finite-difference check
     for (size_t k = 0; k < ids_.size(); ++k) {
       const Vec3 d = seg(q, ids_[k]) - targets_[targets_.size() == 1 ? 0 : k];
       val += 0.5 * w_ * d.squaredNorm();
       seg(g, ids_[k]) += w_ * d;
     }
-    return val;
+    return double(val);
   }
 
  private:
@@ -111,7 +111,7 @@ class ShapeTerm : public ObjectiveTerm {
   std::string name() const override { return "shape"; }
   int frame() const override { return frame_; }
   double eval(const VecX& x, const VecX&, VecX& gx, VecX&) const override {
-    double val = 0;
+    long double val = 0;  // extended: round-off in φ sets the floor of a finite-difference check
     for (int i : ids_) {
       const Vec2 q(x[3 * i], x[3 * i + 2]);
       bool inside = false;
@@ -135,7 +135,7 @@ class ShapeTerm : public ObjectiveTerm {
       gx[3 * i] += w_ * g.x();
       gx[3 * i + 2] += w_ * g.y();
     }
-    return val;
+    return double(val);
   }
 
  private:
@@ -153,7 +153,7 @@ class ArchTerm : public ObjectiveTerm {
   std::string name() const override { return "arch"; }
   int frame() const override { return frame_; }
   double eval(const VecX& x, const VecX&, VecX& gx, VecX&) const override {
-    double val = 0;
+    long double val = 0;  // extended: round-off in φ sets the floor of a finite-difference check
     for (int i : ids_) {
       const Vec3 d = seg(x, i) - a_;
       const Vec3 perp = d - d.dot(e_) * e_;
@@ -163,7 +163,7 @@ class ArchTerm : public ObjectiveTerm {
       val += 0.5 * w_ * err * err;
       seg(gx, i) += w_ * err * perp / len;
     }
-    return val;
+    return double(val);
   }
 
  private:

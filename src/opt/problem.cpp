@@ -43,7 +43,7 @@ double Problem::evaluate(const VecX& z, VecX* grad) {
   options.checkpoint_every = grad ? checkpoint_every_ : 0;
   options.keep_for = this;
   bool ok = simulate(sys_, x0_, v0_, time_.steps(), u_at, rollout_, options);
-  double phi = 0;
+  long double phi = 0;  // extended, like each term's sum: φ's round-off is a gradient check's floor
   breakdown_.clear();
   if (ok) {
     VecX gx = VecX::Zero(sys_.dof()), gv = VecX::Zero(sys_.dof());
@@ -71,8 +71,8 @@ double Problem::evaluate(const VecX& z, VecX* grad) {
   if (ok) {
     have_good_ = true;
     z_good_ = z;
-    phi_good_ = phi;
-    return phi;
+    phi_good_ = double(phi);
+    return double(phi);
   }
   // Diverged: a smooth bowl around the last good point, far above anything a good step gives. Every
   // quantity is formed so that huge trial controls (or a huge last good point) cannot overflow it.

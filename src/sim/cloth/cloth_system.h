@@ -105,6 +105,7 @@ class ClothSystem final : public System {
     double total() const { return kinetic + gravity + elastic + contact; }
   };
   Energy energy(int n, const VecX& x, const VecX& v) const;
+  Vec3 stiffness_times_velocity(int i, const VecX& v) const;
   // PCG iterations of the last forward / backward solve (benchmarks, logs).
   int last_cg_iterations() const { return last_cg_; }
   int last_adjoint_cg_iterations() const { return last_adjoint_cg_; }
@@ -147,8 +148,9 @@ class ClothSystem final : public System {
   // Per-step work space, sized once.
   std::vector<Vec3> spring_f_;
   std::vector<Mat3> spring_K_, spring_D_;
+  std::vector<Mat3> contact_K_;  // per particle: the colliders' part of K's diagonal block
   BlockSparse3 K_, D_, A_;
-  VecX force_, rhs_, dv_, kv_, aw_;
+  VecX force_, rhs_, dv_, aw_;
   FilteredPcg pcg_;
   FilteredDirect direct_;  // cloth.solver = "direct"
   bool direct_solve_ = false, direct_ok_ = false;
