@@ -14,11 +14,11 @@ namespace kf {
 void add_gradcheck_command(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "gradcheck",
-      "compare the adjoint gradient with central finite differences (steps eps, eps/10, eps/100; the adjacent pair "
-      "that agrees better, Richardson-extrapolated) on a sample of control coordinates; samples whose differences "
-      "disagree by more than --kink-tolerance straddle a kink of the objective and are counted as kinks, not as "
-      "adjoint error; fd_spread is the check's own resolution; prints one JSON object (checked, kinks, "
-      "max_rel_error, cosine, rel_error_norm, fd_spread, ...)");
+      "compare the adjoint gradient with central finite differences on a sample of control coordinates (steps eps, "
+      "eps/2, eps/4, ... Richardson-extrapolated, until two extrapolations agree or the objective's round-off "
+      "takes over); samples whose estimates never agree to --kink-tolerance straddle a kink of the objective and "
+      "are counted as kinks, not as adjoint error; fd_spread is the check's own resolution; prints one JSON "
+      "object (checked, kinks, max_rel_error, cosine, rel_error_norm, fd_spread, phi_noise, ...)");
   struct Options {
     std::string scene;
     int samples = 40, frames = 0, substeps = 0;
@@ -30,11 +30,11 @@ void add_gradcheck_command(CLI::App& app) {
   auto o = std::make_shared<Options>();
   sub->add_option("SCENE", o->scene, "scene file (JSON)")->required();
   sub->add_option("--samples", o->samples, "coordinates to compare")->check(CLI::Range(1, 100000));
-  sub->add_option("--eps", o->eps, "the larger finite-difference step, relative to max(1, |z|)")
+  sub->add_option("--eps", o->eps, "the first (largest) finite-difference step, relative to max(1, |z|)")
       ->check(CLI::Range(1e-12, 1.0))
       ->capture_default_str();
   sub->add_option("--kink-tolerance", o->kink_tolerance,
-                  "relative disagreement of the differences beyond which a sample is a kink")
+                  "relative error estimate of the differences beyond which a sample is a kink")
       ->check(CLI::Range(0.0, 1e300))
       ->capture_default_str();
   sub->add_option("--solver", o->solver,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <limits>
 #include <random>
 
 namespace kf {
@@ -11,7 +12,7 @@ nlohmann::json GradcheckResult::to_json() const {
   return {{"checked", checked},     {"kinks", kinks},         {"max_rel_error", max_rel_error},
           {"cosine", cosine},       {"rel_error_norm", rel_error_norm}, {"fd_spread", fd_spread},
           {"floor", floor},         {"grad_norm", grad_norm}, {"phi", phi},
-          {"eps", eps}};
+          {"eps", eps}, {"phi_noise", phi_noise}};
 }
 
 namespace {
@@ -34,15 +35,59 @@ std::vector<int> pick_coordinates(const VecX& g, int samples, unsigned seed) {
   return picks;
 }
 
+// The round-off σ of φ near z: φ along a random direction at steps so small that φ is linear there; its
+// second differences are then round-off alone (each has variance 6σ²).
+double phi_noise(Problem& problem, const VecX& z, double phi, unsigned seed) {
+  std::mt19937_64 rng(seed + 1);
+  std::normal_distribution<double> normal;
+  VecX dir(z.size());
+  for (int i = 0; i < z.size(); ++i) dir[i] = normal(rng);
+  const double delta = 1e-9 * std::max(1.0, z.cwiseAbs().maxCoeff()) / std::max(dir.norm(), 1e-300);
+  double f[7];
+  for (int j = -3; j <= 3; ++j) f[j + 3] = j == 0 ? phi : problem.evaluate(VecX(z + j * delta * dir), nullptr);
+  double sum = 0;
+  for (int j = 1; j < 6; ++j) sum += std::pow(f[j + 1] - 2 * f[j] + f[j - 1], 2);
+  // At least φ's own rounding: a φ that is linear to the last bit there still quantises differences.
+  return std::max(std::sqrt(sum / 5 / 6), std::numeric_limits<double>::epsilon() * std::abs(phi));
+}
+
 }  // namespace
 
+DifferenceEstimate extrapolated_difference(double step, const std::function<double(double)>& central,
+                                           double target, double noise) {
+  constexpr int kLevels = 16;  // down to step / 2^15
+  constexpr int kNoisy = 3;    // levels in a row whose change round-off explains: smaller steps only lose
+  DifferenceEstimate best{0, std::numeric_limits<double>::infinity()};
+  double h = step, d_prev = central(h), r_prev = 0;
+  int noisy = 0;
+  for (int i = 1; i < kLevels; ++i) {
+    h /= 2;
+    const double d = central(h);
+    const double r = (4 * d - d_prev) / 3;  // Richardson: the pair's O(h²) error cancels
+    if (i >= 2) {
+      // Three times the change: a sequence growing like 1/h (a jump of φ) is twice its last change away
+      // from where it started. r's round-off is about noise / h.
+      const double change = std::abs(r - r_prev), error = 3 * change + 3 * noise / h;
+      if (error < best.error) best = {r, error};
+      if (best.error <= target * std::abs(best.value)) break;
+      noisy = change <= 10 * noise / h ? noisy + 1 : 0;
+      if (noisy == kNoisy) break;
+    }
+    d_prev = d;
+    r_prev = r;
+  }
+  return best;
+}
+
 GradcheckResult gradcheck(Problem& problem, const VecX& z, const GradcheckOptions& o) {
+  constexpr double kResolution = 1e-9;  // a relative error estimate at which a sample needs no smaller steps
   GradcheckResult r;
   r.eps = o.eps;
   VecX g(z.size());
   r.phi = problem.evaluate(z, &g);
   r.grad_norm = g.norm();
   const std::vector<int> picks = pick_coordinates(g, o.samples, o.seed);
+  r.phi_noise = phi_noise(problem, z, r.phi, o.seed);
   VecX zp = z;
   auto central = [&](int k, double step) {
     zp[k] = z[k] + step;
@@ -53,19 +98,13 @@ GradcheckResult gradcheck(Problem& problem, const VecX& z, const GradcheckOption
     return (fp - fm) / (2 * step);
   };
   const int m = int(picks.size());
-  // Per sample: differences at eps, eps/10 and eps/100; the adjacent pair that agrees better is used (the
-  // larger pair where the finer one drowns in round-off, the finer where φ curves strongly at eps).
   VecX spread(m), fd(m);
   for (int s = 0; s < m; ++s) {
     const double step = o.eps * std::max(1.0, std::abs(z[picks[s]]));
-    double d[3];
-    for (int k = 0; k < 3; ++k) d[k] = central(picks[s], step * std::pow(0.1, k));
-    const double scale = std::max({std::abs(d[1]), std::abs(d[2]), 1e-300});
-    const double s01 = std::abs(d[0] - d[1]) / scale, s12 = std::abs(d[1] - d[2]) / scale;
-    const int c = s12 < s01 ? 1 : 0;  // the pair (c, c+1)
-    spread[s] = std::min(s01, s12);
-    // Richardson's extrapolation cancels the pair's O(step^2) error.
-    fd[s] = d[c + 1] + (d[c + 1] - d[c]) / 99;
+    const DifferenceEstimate e =
+        extrapolated_difference(step, [&](double h) { return central(picks[s], h); }, kResolution, r.phi_noise);
+    fd[s] = e.value;
+    spread[s] = e.error / std::max(std::abs(e.value), 1e-300);
   }
   r.floor = m > 0 ? 1e-3 * fd.cwiseAbs().maxCoeff() : 0.0;
   double dot = 0, na = 0, nf = 0, ne = 0;

@@ -1,7 +1,7 @@
 // The exact cloth adjoint against finite differences of whole simulations (keyframe gradcheck's check):
 // small scenes with each collider, pins, compression, per-step and initial-velocity controls, at steps
-// from 1/30 to 1/960 s and at zero and perturbed controls. The adjoint must agree to 1e-6, or to the
-// differences' own resolution (fd_spread) where that is coarser: an adjoint error above both fails.
+// from 1/30 to 1/960 s and at zero and perturbed controls. The adjoint must agree to 1e-6 on every
+// checked sample, and at most a few samples may be kinks (differences that never converge).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -40,6 +40,12 @@ const Case kCases[] = {
        "radius": 0.15, "tube_radius": 0.03, "thickness": 0.03, "stiffness": 3000}])",
      R"({"kind": "initial_velocity", "alpha": 1e-4})",
      R"([{"type": "center_of_mass", "frame": 3, "weight": 100, "target": [0, 1.2, 0]}])", 1e-3},
+    {"torus_rigid_throw", R"("origin": [-0.45, 0.95, -0.1], "width": 0.2, "height": 0.2, "v_axis": [0, 0, 1],
+       "velocity": [3, 1, 0], "colliders": [{"type": "torus", "center": [0, 1.05, 0], "axis": [1, 0, 0],
+       "radius": 0.15, "tube_radius": 0.03, "thickness": 0.03, "stiffness": 3000}])",
+     R"({"kind": "initial_rigid_velocity", "alpha": 1e-4})",
+     R"([{"type": "position", "frame": 3, "weight": 100, "particles": [0, 35], "targets": [[-0.1, 1.1, -0.1], [0.1, 1.2, 0.1]]}])",
+     1e-3},
     {"compressed_arch", R"("origin": [-0.25, 0, -0.25], "v_axis": [0, 0, 1], "gravity": [0, 0, 0])",
      R"({"kind": "per_frame", "alpha": 1e-5})",
      R"([{"type": "arch", "frame": 3, "weight": 100, "axis_point": [0, -0.2, 0], "axis": [0, 0, 1], "radius": 0.3}])",
@@ -49,7 +55,7 @@ const Case kCases[] = {
 Scene scene_of(const Case& c, int substeps) {
   return parse_scene(std::string(R"({"time": {"fps": 30, "frames": 3, "substeps": )") + std::to_string(substeps) +
                          R"(}, "cloth": {"nx": 6, "ny": 6, "width": 0.5, "height": 0.5, "mass": 0.1,
-                            "cg_tolerance": 1e-13, "cg_max_iterations": 20000, )" +
+                            "solver": "direct", )" +
                          c.cloth + R"(}, "controls": )" + c.controls + R"(, "objectives": )" + c.objectives + "}",
                      std::string(c.name) + ".json");
 }
@@ -71,9 +77,8 @@ TEST_P(ClothExactAdjoint, MatchesFiniteDifferencesAtEveryStepAndPerturbation) {
       std::printf("%s h = 1/%d, perturb %g: max_rel_error %.2e, fd_spread %.2e, %d checked, %d kinks\n", c.name,
                   30 * substeps, perturb, r.max_rel_error, r.fd_spread, r.checked, r.kinks);
       ASSERT_GT(r.grad_norm, 0) << c.name;
-      EXPECT_GE(r.checked, std::min(12, problem.size() / 2)) << c.name << " h = 1/" << 30 * substeps;
-      EXPECT_LE(r.max_rel_error, std::max(1e-6, 2 * r.fd_spread))
-          << c.name << " h = 1/" << 30 * substeps << " perturb " << perturb;
+      EXPECT_GE(r.checked, std::min(14, problem.size())) << c.name << " h = 1/" << 30 * substeps;
+      EXPECT_LE(r.max_rel_error, 1e-6) << c.name << " h = 1/" << 30 * substeps << " perturb " << perturb;
     }
   }
 }
