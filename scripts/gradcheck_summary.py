@@ -1,0 +1,24 @@
+#!/usr/bin/env python3
+"""Summarises a gradcheck_table.py CSV as the README's markdown table: one row per scene and adjoint.
+
+Usage: scripts/gradcheck_summary.py tests/results/gradcheck_scenes.csv"""
+import csv, sys
+from collections import OrderedDict
+
+rows = list(csv.DictReader(open(sys.argv[1])))
+groups = OrderedDict()
+for r in rows:
+    groups.setdefault((r["scene"], r["adjoint"]), []).append(r)
+print("| scene | h (frames) | adjoint | checks | max_rel_error, worst | checks ≤ 1e-6 | largest fd_spread | lowest cosine | kinks |")
+print("|---|---|---|---|---|---|---|---|---|")
+for (scene, adjoint), g in groups.items():
+    steps = OrderedDict()
+    for r in g:
+        steps.setdefault(r["dt"], set()).add(r["frames"])
+    h = ", ".join(f"{dt} ({'/'.join(sorted(f))})" for dt, f in steps.items())
+    err = [float(r["max_rel_error"]) for r in g]
+    kinks = sum(int(r["kinks"]) for r in g)
+    samples = sum(int(r["kinks"]) + int(r["checked"]) for r in g)
+    print(f"| {scene.removesuffix('.json')} | {h} | {adjoint} | {len(g)} | {max(err):.1e} | "
+          f"{sum(e <= 1e-6 for e in err)} of {len(g)} | {max(float(r['fd_spread']) for r in g):.1e} | "
+          f"{min(float(r['cosine']) for r in g):.6f} | {kinks} of {samples} |")
