@@ -279,7 +279,7 @@ void build_cloth(const Scene& scene, const Trajectory& traj, int f, double scale
     for (int i = 0; i + 1 < nx; ++i) {
       bool odd = false;
       if (squares > 0) {
-        const int si = (i * squares) / (nx - 1), sj = (j * squares) / (nx - 1);
+        const int si = (i * squares) / (nx - 1), sj = (j * squares) / (ny - 1);
         odd = ((si + sj) & 1) != 0;
       }
       const Vec3 front = odd ? rs.cloth_front * 0.72 : rs.cloth_front;
