@@ -1,9 +1,10 @@
 #include "sim/cloth/collider.h"
 
 #include <cmath>
-#include <stdexcept>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+
+#include "core/overloaded.h"
 
 namespace kf {
 
@@ -52,8 +53,8 @@ Vec3 DistanceCollider::definite_stiffness_derivative(int, const Vec3& x, const V
   return ddg * wn * cn * n - dg * (cn * (dn.transpose() * w) + wn * (dn.transpose() * c));
 }
 
-GroundCollider::GroundCollider(const ColliderSpec& s, double ramp)
-    : DistanceCollider(s.thickness, s.stiffness, ramp), point_(s.center), normal_(s.axis.normalized()) {}
+GroundCollider::GroundCollider(const GroundShape& s, double thickness, double stiffness, double ramp)
+    : DistanceCollider(thickness, stiffness, ramp), point_(s.point), normal_(s.normal.normalized()) {}
 
 void GroundCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const {
   phi = normal_.dot(x - point_);
@@ -61,8 +62,8 @@ void GroundCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dn
   dnormal_dx.setZero();
 }
 
-SphereCollider::SphereCollider(const ColliderSpec& s, double ramp)
-    : DistanceCollider(s.thickness, s.stiffness, ramp), center_(s.center), radius_(s.radius) {}
+SphereCollider::SphereCollider(const SphereShape& s, double thickness, double stiffness, double ramp)
+    : DistanceCollider(thickness, stiffness, ramp), center_(s.center), radius_(s.radius) {}
 
 void SphereCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const {
   const Vec3 d = x - center_;
@@ -78,8 +79,8 @@ void SphereCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dn
   dnormal_dx = (Mat3::Identity() - normal * normal.transpose()) / r;
 }
 
-TorusCollider::TorusCollider(const ColliderSpec& s, double ramp)
-    : DistanceCollider(s.thickness, s.stiffness, ramp),
+TorusCollider::TorusCollider(const TorusShape& s, double thickness, double stiffness, double ramp)
+    : DistanceCollider(thickness, stiffness, ramp),
       center_(s.center),
       axis_(s.axis.normalized()),
       major_(s.radius),
@@ -119,10 +120,19 @@ std::vector<std::unique_ptr<Collider>> make_colliders(const std::vector<Collider
   std::vector<std::unique_ptr<Collider>> out;
   for (const ColliderSpec& s : specs) {
     const double ramp = ramp_fraction * s.thickness;
-    if (s.type == "ground") out.push_back(std::make_unique<GroundCollider>(s, ramp));
-    else if (s.type == "sphere") out.push_back(std::make_unique<SphereCollider>(s, ramp));
-    else if (s.type == "torus") out.push_back(std::make_unique<TorusCollider>(s, ramp));
-    else throw std::invalid_argument("unknown collider type \"" + s.type + "\"");
+    out.push_back(std::visit(
+        Overloaded{
+            [&](const GroundShape& g) -> std::unique_ptr<Collider> {
+              return std::make_unique<GroundCollider>(g, s.thickness, s.stiffness, ramp);
+            },
+            [&](const SphereShape& g) -> std::unique_ptr<Collider> {
+              return std::make_unique<SphereCollider>(g, s.thickness, s.stiffness, ramp);
+            },
+            [&](const TorusShape& g) -> std::unique_ptr<Collider> {
+              return std::make_unique<TorusCollider>(g, s.thickness, s.stiffness, ramp);
+            },
+        },
+        s.shape));
   }
   return out;
 }
