@@ -124,6 +124,19 @@ void add_torus(Mesh& m, const Vec3& center, const Vec3& axis, double R, double r
   });
 }
 
+// A capsule: the hemisphere at b (rows 0..kRows), the cylinder (one band), the hemisphere at a.
+void add_capsule(Mesh& m, const Vec3& a, const Vec3& b, double r, const Vec3& color) {
+  const Vec3 e = (b - a).normalized(), e1 = any_perpendicular(e), e2 = e.cross(e1);
+  constexpr int kRows = 12;  // per cap
+  add_periodic_surface(m, 48, 2 * kRows + 1, color, [&](double u, double v, Vec3& p, Vec3& n) {
+    const int j = int(std::lround(v * (2 * kRows + 1) / (2.0 * M_PI)));
+    const bool at_b = j <= kRows;
+    const double theta = 0.5 * M_PI * (at_b ? j : j - 1) / kRows;  // from b's pole (0) to a's (pi)
+    n = std::cos(theta) * e + std::sin(theta) * (std::cos(u) * e1 + std::sin(u) * e2);
+    p = (at_b ? b : a) + r * n;
+  });
+}
+
 // Small octahedron: a target point in space.
 void add_marker(Mesh& m, const Vec3& c, double s, const Vec3& color) {
   const Vec3 X = Vec3::UnitX() * s, Y = Vec3::UnitY() * s, Z = Vec3::UnitZ() * s;
@@ -142,6 +155,7 @@ void add_collider(Mesh& m, const ColliderShape& shape, const Vec3& color) {
                  [](const GroundShape&) {},
                  [&](const SphereShape& s) { add_sphere(m, s.center, s.radius, color); },
                  [&](const TorusShape& t) { add_torus(m, t.center, t.axis, t.radius, t.tube_radius, color); },
+                 [&](const CapsuleShape& c) { add_capsule(m, c.a, c.b, c.radius, color); },
              },
              shape);
 }
@@ -156,6 +170,10 @@ void add_collider_bounds(const ColliderShape& shape, Bounds& b) {
                  [&](const TorusShape& t) {
                    b.add(t.center - Vec3::Constant(t.radius + t.tube_radius));
                    b.add(t.center + Vec3::Constant(t.radius + t.tube_radius));
+                 },
+                 [&](const CapsuleShape& c) {
+                   b.add(c.a.cwiseMin(c.b) - Vec3::Constant(c.radius));
+                   b.add(c.a.cwiseMax(c.b) + Vec3::Constant(c.radius));
                  },
              },
              shape);

@@ -44,6 +44,15 @@ ColliderShape parse_torus(Block& b) {
   return t;
 }
 
+ColliderShape parse_capsule(Block& b) {
+  CapsuleShape c;
+  c.a = b.vec3("a", c.a);
+  c.b = b.vec3("b", c.b);
+  if ((c.b - c.a).norm() < 1e-6) b.fail("b", "expected a point away from \"a\" (the capsule's axis)");
+  c.radius = b.number("radius", c.radius, 1e-4, 1e4);
+  return c;
+}
+
 struct ColliderType {
   const char* name;
   ColliderShape (*parse)(Block&);
@@ -52,6 +61,7 @@ const ColliderType kColliderTypes[] = {
     {GroundShape::kName, parse_ground},
     {SphereShape::kName, parse_sphere},
     {TorusShape::kName, parse_torus},
+    {CapsuleShape::kName, parse_capsule},
 };
 
 ColliderSpec parse_collider(Block b) {

@@ -34,7 +34,15 @@ struct TorusShape {
   double radius = 0.5;        // major radius (centre of the tube), metres
   double tube_radius = 0.05;  // minor radius, metres (less than radius)
 };
-using ColliderShape = std::variant<GroundShape, SphereShape, TorusShape>;
+// A rod with round ends: the points within `radius` of the segment from a to b.
+struct CapsuleShape {
+  static constexpr const char* kName = "capsule";
+  Vec3 a = Vec3::Zero();    // one end of the axis segment, metres
+  Vec3 b = Vec3::UnitX();   // the other end (distinct from a)
+  double radius = 0.1;      // metres
+};
+
+using ColliderShape = std::variant<GroundShape, SphereShape, TorusShape, CapsuleShape>;
 
 // A collider the cloth is pushed out of by stiff springs inside `thickness`.
 struct ColliderSpec {

@@ -128,6 +128,7 @@ constexpr double kThickness = 0.02, kStiffness = 1e4, kRamp = 0.5 * kThickness;
 const GroundShape kGround{kCenter, kAxis};
 const SphereShape kSphere{kCenter, 0.4};
 const TorusShape kTorus{kCenter, kAxis, 0.4, 0.05};
+const CapsuleShape kCapsule{kCenter, kCenter + Vec3(0.5, 0.3, -0.2), 0.1};
 
 TEST(ClothCollider, GroundJacobianAndSeparation) {
   const GroundShape& s = kGround;
@@ -184,12 +185,44 @@ TEST(ClothCollider, TorusJacobianMatchesFiniteDifferences) {
   EXPECT_TRUE(out.f.allFinite() && out.dfdx.allFinite());
 }
 
+TEST(ClothCollider, CapsuleJacobianMatchesFiniteDifferences) {
+  const CapsuleShape& s = kCapsule;
+  CapsuleCollider c(s, kThickness, kStiffness, kRamp);
+  const Vec3 e = (s.b - s.a).normalized(), e1 = e.unitOrthogonal(), e2 = e.cross(e1);
+  const double length = (s.b - s.a).norm();
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> angle(0, 2 * M_PI), along(0.05, 0.95), U(-0.9, 0.9), cap(0.1, 1.4);
+  for (int t = 0; t < 10; ++t) {  // beside the cylinder, away from the caps' seams
+    const double th = angle(rng);
+    const Vec3 radial = std::cos(th) * e1 + std::sin(th) * e2;
+    check_contact(c, s.a + along(rng) * length * e + (s.radius + U(rng) * kThickness) * radial, "capsule side");
+  }
+  for (int t = 0; t < 10; ++t) {  // on the caps, beyond either end
+    const double th = angle(rng), polar = cap(rng);
+    const Vec3 radial = std::cos(th) * e1 + std::sin(th) * e2;
+    const Vec3 dir = std::cos(polar) * e + std::sin(polar) * radial;
+    const double d = s.radius + U(rng) * kThickness;
+    check_contact(c, t % 2 ? Vec3(s.b + d * dir) : Vec3(s.a - d * dir), "capsule cap");
+  }
+  check_whole_cloth_derivative(c, {s.a + 0.5 * length * e + (s.radius + 0.4 * kThickness) * e1,
+                                   s.b + (s.radius + 0.2 * kThickness) * (e + e2).normalized(),
+                                   s.a - (s.radius - 0.5 * kThickness) * e, s.a + 0.3 * length * e + 3 * s.radius * e2},
+                               "capsule");
+  ContactForce out;
+  EXPECT_FALSE(c.contact(0, s.a + 0.5 * length * e + (s.radius + 1.01 * kThickness) * e1, Vec3::Zero(), false, out));
+  EXPECT_FALSE(c.contact(0, s.b + (s.radius + 1.01 * kThickness) * e, Vec3::Zero(), false, out));
+  EXPECT_TRUE(c.contact(0, s.a + 0.5 * length * e, Vec3::Zero(), false, out));  // on the axis: a finite push
+  EXPECT_TRUE(out.f.allFinite() && out.dfdx.allFinite());
+  EXPECT_NEAR(out.f.dot(e), 0.0, 1e-12);
+}
+
 TEST(ClothCollider, FactoryBuildsOnePerSpecAndNoneForNone) {
   EXPECT_TRUE(make_colliders({}, 0.5).empty());
   const auto spec = [](ColliderShape shape) { return ColliderSpec{shape, kThickness, kStiffness}; };
-  auto cs = make_colliders({spec(kGround), spec(kSphere), spec(kTorus)}, 0.5);
-  ASSERT_EQ(cs.size(), 3u);
+  auto cs = make_colliders({spec(kGround), spec(kSphere), spec(kTorus), spec(kCapsule)}, 0.5);
+  ASSERT_EQ(cs.size(), 4u);
   EXPECT_NE(dynamic_cast<TorusCollider*>(cs[2].get()), nullptr);
+  EXPECT_NE(dynamic_cast<CapsuleCollider*>(cs[3].get()), nullptr);
 }
 
 }  // namespace

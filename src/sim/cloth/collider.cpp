@@ -1,6 +1,9 @@
 #include "sim/cloth/collider.h"
 
+#include <algorithm>
 #include <cmath>
+
+#include <Eigen/Geometry>  // unitOrthogonal
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -116,6 +119,33 @@ void TorusCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dno
   dnormal_dx = (Mat3::Identity() - normal * normal.transpose()) / d * dw;
 }
 
+CapsuleCollider::CapsuleCollider(const CapsuleShape& s, double thickness, double stiffness, double ramp)
+    : DistanceCollider(thickness, stiffness, ramp),
+      a_(s.a),
+      axis_((s.b - s.a).normalized()),
+      length_((s.b - s.a).norm()),
+      radius_(s.radius) {}
+
+void CapsuleCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const {
+  // The closest point of the segment: q = a + t axis, t clamped to [0, length].
+  const double s = axis_.dot(x - a_);
+  const bool side = s > 0 && s < length_;  // beside the cylinder, not at a cap
+  const Vec3 q = a_ + std::clamp(s, 0.0, length_) * axis_;
+  const Vec3 w = x - q;
+  const double d = w.norm();
+  if (d < 1e-12 * radius_) {  // on the axis every direction across it is as near; pick one so the push is finite
+    phi = -radius_;
+    normal = axis_.unitOrthogonal();
+    dnormal_dx.setZero();
+    return;
+  }
+  phi = d - radius_;
+  normal = w / d;
+  // dn/dx = (I - n n^T)/d dw/dx, with dw/dx = I - axis axis^T beside the cylinder and I at a cap.
+  const Mat3 across = (Mat3::Identity() - normal * normal.transpose()) / d;
+  dnormal_dx = side ? Mat3(across * (Mat3::Identity() - axis_ * axis_.transpose())) : across;
+}
+
 std::vector<std::unique_ptr<Collider>> make_colliders(const std::vector<ColliderSpec>& specs, double ramp_fraction) {
   std::vector<std::unique_ptr<Collider>> out;
   for (const ColliderSpec& s : specs) {
@@ -130,6 +160,9 @@ std::vector<std::unique_ptr<Collider>> make_colliders(const std::vector<Collider
             },
             [&](const TorusShape& g) -> std::unique_ptr<Collider> {
               return std::make_unique<TorusCollider>(g, s.thickness, s.stiffness, ramp);
+            },
+            [&](const CapsuleShape& g) -> std::unique_ptr<Collider> {
+              return std::make_unique<CapsuleCollider>(g, s.thickness, s.stiffness, ramp);
             },
         },
         s.shape));

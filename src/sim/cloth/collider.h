@@ -93,6 +93,17 @@ class TorusCollider final : public DistanceCollider {
   double major_, tube_;
 };
 
+// A capsule: distance to the segment a-b minus the radius (a cylinder with hemispherical caps).
+class CapsuleCollider final : public DistanceCollider {
+ public:
+  CapsuleCollider(const CapsuleShape& s, double thickness, double stiffness, double ramp);
+  void distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const override;
+
+ private:
+  Vec3 a_, axis_;  // one end and the unit direction to the other
+  double length_, radius_;
+};
+
 // One collider per spec entry, in order, each shape's class chosen by std::visit (empty for a scene without colliders). ramp_fraction: each
 // contact profile's ramp as a fraction of its collider's thickness.
 std::vector<std::unique_ptr<Collider>> make_colliders(const std::vector<ColliderSpec>& specs, double ramp_fraction);
