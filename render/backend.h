@@ -30,6 +30,8 @@ class Backend {
 std::vector<std::string> backend_names();
 // Creates a back end by name; throws InputError naming the choices for an unknown one.
 std::unique_ptr<Backend> make_backend(const std::string& name);
+// Samples per pixel of the named back end when RenderSettings::spp is 0 (osmesa: 4, embree: look.samples).
+int default_spp(const std::string& name, const RenderSpec& look);
 
 // Constructors of the individual back ends (raster/, rt/).
 std::unique_ptr<Backend> make_raster_backend();

@@ -3,6 +3,7 @@
 #include <fstream>
 
 #include "core/error.h"
+#include "core/overloaded.h"
 
 namespace kf::render {
 
@@ -40,9 +41,13 @@ FrameRenderer::FrameRenderer(const RunData& run, const std::string& backend, Ren
     : run_(run), backend_(make_backend(backend)), settings_(settings) {
   if (settings_.width == 0) settings_.width = run.scene.render.width;
   if (settings_.height == 0) settings_.height = run.scene.render.height;
-  if (settings_.spp == 0) settings_.spp = backend == "embree" ? run.scene.render.samples : 4;
+  if (settings_.spp == 0) settings_.spp = default_spp(backend, run.scene.render);
   bounds_ = scene_bounds(run.scene, run.trajectory, run.meshes ? &*run.meshes : nullptr);
-  camera_ = make_camera(run.scene.render, bounds_, run.scene.flock.has_value(), settings_.width, settings_.height);
+  const bool planar = visit_system(run.scene, Overloaded{
+                                                  [](const FlockSpec&) { return true; },  // seen from above
+                                                  [](const ClothSpec&) { return false; },
+                                              });
+  camera_ = make_camera(run.scene.render, bounds_, planar, settings_.width, settings_.height);
 }
 
 Image FrameRenderer::render(int frame, double orbit) {

@@ -12,6 +12,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/overloaded.h"
 #include "render/frame_renderer.h"
 
 namespace kf::render {
@@ -110,34 +111,40 @@ ExportMesh from_render_mesh(const std::string& name, const Mesh& m, const Vec3& 
   return e;
 }
 
+// The cloth grid at one frame as a triangle mesh with area-weighted vertex normals.
+ExportMesh cloth_mesh(const RunData& run, const ClothSpec& cloth, int frame) {
+  const int nx = cloth.nx, ny = cloth.ny;
+  const VecX& x = run.trajectory.x[size_t(frame)];
+  ExportMesh e{"cloth", {}, {}, {}, run.scene.render.cloth_front};
+  std::vector<Vec3> normal(size_t(nx) * ny, Vec3::Zero());
+  for (int j = 0; j + 1 < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {
+      const uint32_t a = uint32_t(j * nx + i), b = a + 1, c = a + uint32_t(nx) + 1, d = a + uint32_t(nx);
+      e.indices.insert(e.indices.end(), {a, b, c, a, c, d});
+      const Vec3 n1 = (seg(x, int(b)) - seg(x, int(a))).cross(seg(x, int(c)) - seg(x, int(a)));
+      const Vec3 n2 = (seg(x, int(c)) - seg(x, int(a))).cross(seg(x, int(d)) - seg(x, int(a)));
+      for (uint32_t v : {a, b, c}) normal[v] += n1;
+      for (uint32_t v : {a, c, d}) normal[v] += n2;
+    }
+  for (int i = 0; i < nx * ny; ++i) {
+    const Vec3 p = seg(x, i), n = normal[size_t(i)].norm() > 1e-30 ? normal[size_t(i)].normalized() : Vec3::UnitY();
+    e.p.insert(e.p.end(), {float(p.x()), float(p.y()), float(p.z())});
+    e.n.insert(e.n.end(), {float(n.x()), float(n.y()), float(n.z())});
+  }
+  return e;
+}
+
 // The frame's meshes: the particles as a surface (cloth grid or agent arrowheads) and the bodies.
 std::vector<ExportMesh> frame_meshes(const RunData& run, int frame, const Bounds& bounds, FrameGeometry& g) {
   std::vector<ExportMesh> out;
   const RenderSpec& rs = run.scene.render;
-  if (run.scene.cloth) {
-    const int nx = run.scene.cloth->nx, ny = run.scene.cloth->ny;
-    const VecX& x = run.trajectory.x[size_t(frame)];
-    ExportMesh e{"cloth", {}, {}, {}, rs.cloth_front};
-    std::vector<Vec3> normal(size_t(nx) * ny, Vec3::Zero());
-    for (int j = 0; j + 1 < ny; ++j)
-      for (int i = 0; i + 1 < nx; ++i) {
-        const uint32_t a = uint32_t(j * nx + i), b = a + 1, c = a + uint32_t(nx) + 1, d = a + uint32_t(nx);
-        e.indices.insert(e.indices.end(), {a, b, c, a, c, d});
-        const Vec3 n1 = (seg(x, int(b)) - seg(x, int(a))).cross(seg(x, int(c)) - seg(x, int(a)));
-        const Vec3 n2 = (seg(x, int(c)) - seg(x, int(a))).cross(seg(x, int(d)) - seg(x, int(a)));
-        for (uint32_t v : {a, b, c}) normal[v] += n1;
-        for (uint32_t v : {a, c, d}) normal[v] += n2;
-      }
-    for (int i = 0; i < nx * ny; ++i) {
-      const Vec3 p = seg(x, i), n = normal[size_t(i)].norm() > 1e-30 ? normal[size_t(i)].normalized() : Vec3::UnitY();
-      e.p.insert(e.p.end(), {float(p.x()), float(p.y()), float(p.z())});
-      e.n.insert(e.n.end(), {float(n.x()), float(n.y()), float(n.z())});
-    }
-    out.push_back(std::move(e));
-  } else if (run.scene.flock) {
-    build_frame_geometry(run.scene, run.trajectory, frame, bounds, g);
-    out.push_back(from_render_mesh("agents", g.objects, rs.agent_color));
-  }
+  visit_system(run.scene, Overloaded{
+                              [&](const ClothSpec& cloth) { out.push_back(cloth_mesh(run, cloth, frame)); },
+                              [&](const FlockSpec&) {
+                                build_frame_geometry(run.scene, run.trajectory, frame, bounds, g);
+                                out.push_back(from_render_mesh("agents", g.objects, rs.agent_color));
+                              },
+                          });
   if (run.meshes) {
     for (int k = 0; k < int(run.meshes->meshes.size()); ++k) {
       Mesh body;

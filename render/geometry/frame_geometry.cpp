@@ -6,6 +6,8 @@
 
 #include <Eigen/Geometry>
 
+#include "core/overloaded.h"
+
 namespace kf::render {
 
 namespace {
@@ -122,6 +124,19 @@ void add_torus(Mesh& m, const Vec3& center, const Vec3& axis, double R, double r
   });
 }
 
+// A capsule: the hemisphere at b (rows 0..kRows), the cylinder (one band), the hemisphere at a.
+void add_capsule(Mesh& m, const Vec3& a, const Vec3& b, double r, const Vec3& color) {
+  const Vec3 e = (b - a).normalized(), e1 = any_perpendicular(e), e2 = e.cross(e1);
+  constexpr int kRows = 12;  // per cap
+  add_periodic_surface(m, 48, 2 * kRows + 1, color, [&](double u, double v, Vec3& p, Vec3& n) {
+    const int j = int(std::lround(v * (2 * kRows + 1) / (2.0 * M_PI)));
+    const bool at_b = j <= kRows;
+    const double theta = 0.5 * M_PI * (at_b ? j : j - 1) / kRows;  // from b's pole (0) to a's (pi)
+    n = std::cos(theta) * e + std::sin(theta) * (std::cos(u) * e1 + std::sin(u) * e2);
+    p = (at_b ? b : a) + r * n;
+  });
+}
+
 // Small octahedron: a target point in space.
 void add_marker(Mesh& m, const Vec3& c, double s, const Vec3& color) {
   const Vec3 X = Vec3::UnitX() * s, Y = Vec3::UnitY() * s, Z = Vec3::UnitZ() * s;
@@ -134,18 +149,53 @@ void add_marker(Mesh& m, const Vec3& c, double s, const Vec3& color) {
 
 Vec3 mix(const Vec3& a, const Vec3& b, double t) { return (1 - t) * a + t * b; }
 
+// Each collider shape's drawing and the box it takes (a ground is drawn as the floor, ground_plane()).
+void add_collider(Mesh& m, const ColliderShape& shape, const Vec3& color) {
+  std::visit(Overloaded{
+                 [](const GroundShape&) {},
+                 [&](const SphereShape& s) { add_sphere(m, s.center, s.radius, color); },
+                 [&](const TorusShape& t) { add_torus(m, t.center, t.axis, t.radius, t.tube_radius, color); },
+                 [&](const CapsuleShape& c) { add_capsule(m, c.a, c.b, c.radius, color); },
+             },
+             shape);
+}
+
+void add_collider_bounds(const ColliderShape& shape, Bounds& b) {
+  std::visit(Overloaded{
+                 [](const GroundShape&) {},
+                 [&](const SphereShape& s) {
+                   b.add(s.center - Vec3::Constant(s.radius));
+                   b.add(s.center + Vec3::Constant(s.radius));
+                 },
+                 [&](const TorusShape& t) {
+                   b.add(t.center - Vec3::Constant(t.radius + t.tube_radius));
+                   b.add(t.center + Vec3::Constant(t.radius + t.tube_radius));
+                 },
+                 [&](const CapsuleShape& c) {
+                   b.add(c.a.cwiseMin(c.b) - Vec3::Constant(c.radius));
+                   b.add(c.a.cwiseMax(c.b) + Vec3::Constant(c.radius));
+                 },
+             },
+             shape);
+}
+
 GroundPlane ground_plane(const Scene& scene, const Bounds& bounds) {
   GroundPlane g;
-  if (scene.cloth) {
-    for (const auto& c : scene.cloth->colliders)
-      if (c.type == "ground") {
-        g.normal = c.axis.normalized();
-        g.offset = g.normal.dot(c.center);
-        return g;
-      }
-    // No floor in the scene: put one just below everything so the shadows show the height.
-    g.offset = bounds.empty() ? 0.0 : std::min(0.0, bounds.lo.y() - 0.05 * std::max(bounds.radius(), 0.25));
-  }
+  visit_system(scene, Overloaded{
+                          [](const FlockSpec&) {},  // flocks live on y = 0
+                          [&](const ClothSpec& cloth) {
+                            for (const auto& c : cloth.colliders)
+                              if (const auto* ground = std::get_if<GroundShape>(&c.shape)) {
+                                g.normal = ground->normal.normalized();
+                                g.offset = g.normal.dot(ground->point);
+                                return;
+                              }
+                            // No floor in the scene: put one just below everything so the shadows show the
+                            // height.
+                            g.offset = bounds.empty() ? 0.0
+                                                      : std::min(0.0, bounds.lo.y() - 0.05 * std::max(bounds.radius(), 0.25));
+                          },
+                      });
   return g;
 }
 
@@ -212,41 +262,46 @@ void build_flock(const Scene& scene, const Trajectory& traj, int f, double scale
   int next_shape = -1;
   for (size_t k = 0; k < scene.objectives.size(); ++k) {
     const auto& o = scene.objectives[k];
-    if (o.type == "shape" && o.frame >= f &&
+    if (std::holds_alternative<ShapeKeyframe>(o.kind) && o.frame >= f &&
         (next_shape < 0 || o.frame < scene.objectives[next_shape].frame))
       next_shape = int(k);
   }
-  std::vector<const ObjectiveSpec*> com;
+  std::vector<std::pair<int, Vec3>> com;  // (frame, target) of the centre-of-mass keyframes
   for (size_t k = 0; k < scene.objectives.size(); ++k) {
     const auto& o = scene.objectives[k];
-    if (o.type == "shape") {
-      std::vector<Vec3> pts;
-      for (const Vec2& q : o.polygon) pts.push_back(on_ground(q.x(), q.y()));
-      const Vec3 color = int(k) == next_shape ? rs.target_color : mix(rs.target_color, rs.ground_color, 0.6);
-      add_ribbon(g.marks, pts, true, line, n, color);
-    } else if (o.type == "center_of_mass") {
-      com.push_back(&o);
-    } else if (o.type == "position") {
-      const bool single = o.particles.size() == 1;
-      for (size_t t = 0; t < o.targets.size(); ++t) {
-        const Vec3& q = o.targets[t];
-        if (single) {
-          add_ribbon(g.marks, circle_points(on_ground(q.x(), q.z()), n, 0.6 * len, 32), true, 0.6 * line, n,
-                     rs.target_color);
-        } else {
-          add_disc(g.marks, on_ground(q.x(), q.z()), n, 0.15 * len, rs.target_color);
-        }
-      }
-      if (single) highlighted[o.particles[0]] = 1;
-    }
+    std::visit(Overloaded{
+                   [&](const ShapeKeyframe& shape) {
+                     std::vector<Vec3> pts;
+                     for (const Vec2& q : shape.polygon) pts.push_back(on_ground(q.x(), q.y()));
+                     const Vec3 color =
+                         int(k) == next_shape ? rs.target_color : mix(rs.target_color, rs.ground_color, 0.6);
+                     add_ribbon(g.marks, pts, true, line, n, color);
+                   },
+                   [&](const CenterOfMassKeyframe& c) { com.emplace_back(o.frame, c.target); },
+                   [&](const PositionKeyframe& pk) {
+                     const bool single = o.particles.size() == 1;
+                     for (const Vec3& q : pk.targets) {
+                       if (single) {
+                         add_ribbon(g.marks, circle_points(on_ground(q.x(), q.z()), n, 0.6 * len, 32), true,
+                                    0.6 * line, n, rs.target_color);
+                       } else {
+                         add_disc(g.marks, on_ground(q.x(), q.z()), n, 0.15 * len, rs.target_color);
+                       }
+                     }
+                     if (single) highlighted[o.particles[0]] = 1;
+                   },
+                   [](const VelocityKeyframe&) {},  // not drawn
+                   [](const ArchKeyframe&) {},      // cloth only
+               },
+               o.kind);
   }
   if (!com.empty()) {
-    std::stable_sort(com.begin(), com.end(), [](auto* a, auto* b) { return a->frame < b->frame; });
+    std::stable_sort(com.begin(), com.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     Vec3 c0 = Vec3::Zero();
     for (int i = 0; i < p; ++i) c0 += seg(traj.x[0], i);
     c0 /= std::max(p, 1);
     std::vector<Vec3> pts = {on_ground(c0.x(), c0.z())};
-    for (auto* o : com) pts.push_back(on_ground(o->targets[0].x(), o->targets[0].z()));
+    for (const auto& [frame, target] : com) pts.push_back(on_ground(target.x(), target.z()));
     add_ribbon(g.marks, pts, false, line, n, rs.path_color);
     for (size_t k = 1; k < pts.size(); ++k) add_disc(g.marks, pts[k], n, 2.0 * line, rs.path_color);
   }
@@ -279,7 +334,7 @@ void build_cloth(const Scene& scene, const Trajectory& traj, int f, double scale
     for (int i = 0; i + 1 < nx; ++i) {
       bool odd = false;
       if (squares > 0) {
-        const int si = (i * squares) / (nx - 1), sj = (j * squares) / (nx - 1);
+        const int si = (i * squares) / (nx - 1), sj = (j * squares) / (ny - 1);
         odd = ((si + sj) & 1) != 0;
       }
       const Vec3 front = odd ? rs.cloth_front * 0.72 : rs.cloth_front;
@@ -290,20 +345,19 @@ void build_cloth(const Scene& scene, const Trajectory& traj, int f, double scale
         add_vertex(m, P(ci[k], cj[k]), normal[size_t(cj[k]) * nx + ci[k]], front, back);
       m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
     }
-  for (const auto& c : scene.cloth->colliders) {
-    if (c.type == "sphere") add_sphere(m, c.center, c.radius, rs.collider_color);
-    if (c.type == "torus") add_torus(m, c.center, c.axis, c.radius, c.tube_radius, rs.collider_color);
-  }
+  for (const auto& c : scene.cloth->colliders) add_collider(m, c.shape, rs.collider_color);
   // Targets of the keyframes still to come, small beside their own spacing so a sheet of targets does
   // not hide the cloth that reaches it.
   size_t markers = 0;
   for (const auto& o : scene.objectives) {
-    if (o.type != "position" || o.frame < f || o.targets.empty()) continue;
+    const auto* position = std::get_if<PositionKeyframe>(&o.kind);
+    if (!position || o.frame < f || position->targets.empty()) continue;
+    const std::vector<Vec3>& targets = position->targets;
     Bounds tb;
-    for (const Vec3& q : o.targets) tb.add(q);
-    const double spacing = 2 * tb.radius() / std::sqrt(double(o.targets.size()));
-    const double size = o.targets.size() > 1 ? std::min(0.012 * scale, 0.2 * spacing) : 0.012 * scale;
-    for (const Vec3& q : o.targets)
+    for (const Vec3& q : targets) tb.add(q);
+    const double spacing = 2 * tb.radius() / std::sqrt(double(targets.size()));
+    const double size = targets.size() > 1 ? std::min(0.012 * scale, 0.2 * spacing) : 0.012 * scale;
+    for (const Vec3& q : targets)
       if (markers++ < 4096) add_marker(m, q, size, rs.target_color);
   }
 }
@@ -337,20 +391,17 @@ Bounds scene_bounds(const Scene& scene, const Trajectory& traj, const MeshSequen
       for (size_t i = 0; i + 2 < f.size(); i += 3) b.add(Vec3(f[i], f[i + 1], f[i + 2]));
   for (const VecX& x : traj.x)
     for (int i = 0; i < traj.particles; ++i) b.add(seg(x, i));
-  for (const auto& o : scene.objectives) {
-    for (const Vec3& q : o.targets) b.add(q);
-    for (const Vec2& q : o.polygon) b.add(Vec3(q.x(), 0.0, q.y()));
-  }
+  for (const auto& o : scene.objectives)
+    std::visit(Overloaded{
+                   [&](const PositionKeyframe& k) { for (const Vec3& q : k.targets) b.add(q); },
+                   [&](const VelocityKeyframe& k) { for (const Vec3& q : k.targets) b.add(q); },
+                   [&](const CenterOfMassKeyframe& k) { b.add(k.target); },
+                   [&](const ShapeKeyframe& k) { for (const Vec2& q : k.polygon) b.add(Vec3(q.x(), 0.0, q.y())); },
+                   [](const ArchKeyframe&) {},
+               },
+               o.kind);
   if (scene.cloth)
-    for (const auto& c : scene.cloth->colliders) {
-      if (c.type == "sphere") {
-        b.add(c.center - Vec3::Constant(c.radius));
-        b.add(c.center + Vec3::Constant(c.radius));
-      } else if (c.type == "torus") {
-        b.add(c.center - Vec3::Constant(c.radius + c.tube_radius));
-        b.add(c.center + Vec3::Constant(c.radius + c.tube_radius));
-      }
-    }
+    for (const auto& c : scene.cloth->colliders) add_collider_bounds(c.shape, b);
   return b;
 }
 
@@ -365,8 +416,10 @@ void build_frame_geometry(const Scene& scene, const Trajectory& traj, int frame,
   }
   out.marks.clear();
   out.objects.clear();
-  if (scene.flock) build_flock(scene, traj, frame, out.scale, out.plane, out);
-  if (scene.cloth) build_cloth(scene, traj, frame, out.scale, out);
+  visit_system(scene, Overloaded{
+                          [&](const FlockSpec&) { build_flock(scene, traj, frame, out.scale, out.plane, out); },
+                          [&](const ClothSpec&) { build_cloth(scene, traj, frame, out.scale, out); },
+                      });
   if (meshes)
     for (int k = 0; k < int(meshes->meshes.size()); ++k) add_body_mesh(*meshes, frame, k, scene.render.body_color, out.objects);
 }

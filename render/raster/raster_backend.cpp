@@ -10,6 +10,7 @@
 
 #include "render/backend.h"
 #include "render/raster/osmesa_context.h"
+#include "render/shading.h"
 
 namespace kf::render {
 
@@ -37,8 +38,10 @@ void main() {
 }
 )";
 
-constexpr const char* kFragmentShader = R"(#version 450 core
-in vec3 v_pos, v_n, v_front, v_back;
+// The shared lighting (render/shading.h) goes between the two halves.
+constexpr const char* kFragmentHead = R"(#version 450 core
+)";
+constexpr const char* kFragmentMain = R"(in vec3 v_pos, v_n, v_front, v_back;
 uniform int shadow_pass;
 uniform vec3 light_dir;
 uniform vec3 eye;
@@ -52,7 +55,7 @@ void main() {
   vec3 albedo = v_front;
   // The side facing the eye decides the colour, so the cloth is two-sided whatever its winding.
   if (dot(nn, eye - v_pos) < 0.0) { nn = -nn; albedo = v_back; }
-  float sky = 0.75 + 0.25 * nn.y;
+  float sky = sky_light(nn.y);
   float sun = max(dot(nn, light_dir), 0.0);
   color = vec4(albedo * (ambient * sky + sun) * norm_k, 1.0);
 }
@@ -131,10 +134,10 @@ class RasterBackend final : public Backend {
     glUniform3f(loc("eye"), float(camera.eye.x()), float(camera.eye.y()), float(camera.eye.z()));
     glUniform4f(loc("plane"), float(g.plane.normal.x()), float(g.plane.normal.y()), float(g.plane.normal.z()),
                 float(g.plane.offset + lift));
-    const double up_sun = std::max(L.dot(g.plane.normal), 0.2);
-    glUniform1f(loc("ambient"), float(look.ambient));
-    glUniform1f(loc("norm_k"), float(1.0 / (look.ambient + up_sun)));
-    glUniform1f(loc("shadow_alpha"), float(up_sun / (look.ambient + up_sun)));
+    const Lighting light = lighting(look, g.plane);
+    glUniform1f(loc("ambient"), light.ambient);
+    glUniform1f(loc("norm_k"), light.norm_k);
+    glUniform1f(loc("shadow_alpha"), light.shadow_alpha);
 
     glBindFramebuffer(GL_FRAMEBUFFER, msaa_fbo_);
     glViewport(0, 0, width_, height_);
@@ -209,7 +212,8 @@ class RasterBackend final : public Backend {
   void setup(int width, int height, int samples) {
     if (!context_) {
       context_ = std::make_unique<OsMesaContext>(width, height);
-      const GLuint vs = compile(GL_VERTEX_SHADER, kVertexShader), fs = compile(GL_FRAGMENT_SHADER, kFragmentShader);
+      const std::string fragment = std::string(kFragmentHead) + kSkyLightGlsl + kFragmentMain;
+      const GLuint vs = compile(GL_VERTEX_SHADER, kVertexShader), fs = compile(GL_FRAGMENT_SHADER, fragment.c_str());
       program_ = glCreateProgram();
       glAttachShader(program_, vs);
       glAttachShader(program_, fs);

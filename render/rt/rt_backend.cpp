@@ -12,7 +12,8 @@
 #include <cstdint>
 
 #include "render/backend.h"
-#include "render/rt/embree_handles.h"
+#include "core/embree_handles.h"
+#include "render/shading.h"
 
 namespace kf::render {
 
@@ -122,7 +123,7 @@ struct RtMesh {
 
 class RtBackend final : public Backend {
  public:
-  RtBackend() : scene_(device_) {}
+  RtBackend() : device_(new_embree_device()), scene_(new_dynamic_scene(device_)) {}
   ~RtBackend() override {
     for (auto& m : meshes_) m.release(scene_.get());
   }
@@ -151,9 +152,9 @@ class RtBackend final : public Backend {
     sh.sun = normalize(from(look.light_direction));
     orthonormal(sh.sun, sh.sun_t, sh.sun_b);
     sh.sun_radius = float(std::tan(0.5 * look.light_angle * M_PI / 180.0));
-    sh.ambient = float(look.ambient);
-    const double up_sun = std::max(look.light_direction.dot(g.plane.normal), 0.2);
-    sh.norm_k = float(1.0 / (look.ambient + up_sun));
+    const Lighting light = lighting(look, g.plane);
+    sh.ambient = light.ambient;
+    sh.norm_k = light.norm_k;
     sh.eps = float(1e-4 * g.scale);
     sh.ao_distance = float(0.5 * g.scale);
     sh.background = from(look.background);
@@ -263,7 +264,7 @@ class RtBackend final : public Backend {
           float c, sn;
           rng[l].angle(c, sn);
           const V3 d = t * (rr * c) + bt * (rr * sn) + n * std::sqrt(1.0f - r1);  // unit: t, bt, n are
-          sky_weight[l] = 0.75f + 0.25f * n.y;
+          sky_weight[l] = sky_light(n.y);
           if (dot(d, ng) > 0.0f) {
             sky_valid[l] = -1;
             set_ray(sky_rays, l, p, d, sh.ao_distance);

@@ -2,6 +2,17 @@
 
 namespace kf {
 
+Trajectory frames_of(const Rollout& r, const TimeSpec& t, int particles) {
+  Trajectory traj;
+  traj.particles = particles;
+  traj.fps = t.fps;
+  for (int n = 0; n <= r.steps(); n += t.substeps) {
+    traj.x.push_back(r.x[n]);
+    traj.v.push_back(r.v[n]);
+  }
+  return traj;
+}
+
 std::size_t Rollout::stored_bytes() const {
   std::size_t b = 0;
   for (const auto& s : x) b += sizeof(double) * s.size();

@@ -15,7 +15,9 @@
 #include <memory>
 #include <vector>
 
+#include "core/trajectory.h"
 #include "core/types.h"
+#include "scene/time_spec.h"
 #include "sim/system.h"
 
 namespace kf {
@@ -32,6 +34,9 @@ struct Rollout {
   // Bytes held by the state vectors and step contexts (what checkpointing saves; the tape is not counted).
   std::size_t stored_bytes() const;
 };
+
+// The frames of a rollout kept in every state (every t.substeps-th state, from 0): the trajectory of a run.
+Trajectory frames_of(const Rollout& r, const TimeSpec& t, int particles);
 
 // A sum of terms g_n(x_n, v_n) over steps; zero at most steps.
 class StateCost {

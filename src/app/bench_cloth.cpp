@@ -49,7 +49,7 @@ nlohmann::json bench_cloth(const ClothSweepOptions& o, const std::filesystem::pa
       std::cerr << "bench cloth/" << name << ": " << x_name << " = " << fmt(x) << std::endl;
       const BenchPoint p = measure_point(s, po);
       std::vector<std::string> row = {fmt(x), fmt(s.time.h()), std::to_string(s.particles()),
-                                      fmt(s.cloth->cg_tolerance), s.controls.kind};
+                                      fmt(s.cloth->cg_tolerance), control_kind_name(s.controls.kind)};
       for (auto& c : bench_point_row(p)) row.push_back(c);
       t.add(row);
     }

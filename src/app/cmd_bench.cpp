@@ -10,31 +10,21 @@
 
 namespace kf {
 
-void add_bench_command(CLI::App& app) {
-  auto* sub = app.add_subcommand(
-      "bench",
-      "sweep speed against error: cloth (time step, resolution, PCG tolerance, per-step vs per-frame control), "
-      "flock (agents, fitted scaling exponent), memory (peak RSS against steps with and without adjoint "
-      "checkpointing), adjoint (exact against swap on the cloth figures: gradient cost and error, keyframe error "
-      "in the same wall time); writes CSV + PNG under --out");
-  struct Options {
-    std::string out = "out/bench";
-    std::vector<std::string> only;
-    bool quick = false;
-    ClothSweepOptions cloth;
-    FlockSweepOptions flock;
-    MemorySweepOptions memory;
-    AdjointSweepOptions adjoint;
-    int point_steps = 0, point_every = 0, point_resolution = 16;
-  };
-  auto o = std::make_shared<Options>();
-  sub->add_option("--out", o->out, "output directory")->capture_default_str();
-  sub->add_flag("--quick", o->quick,
-                "reduced sweep (a few minutes): substeps 1,4,16; n 16,24,32; tolerances 1e-4,1e-6,1e-8; agents "
-                "100,300,1000; steps 500..4000; fewer samples and evaluations. Options given explicitly win.");
-  sub->add_option("--only", o->only, "run only these sweeps")
-      ->check(CLI::IsMember({"cloth", "flock", "memory", "adjoint"}))
-      ->delimiter(',');
+namespace {
+
+struct BenchOptions {
+  std::string out = "out/bench";
+  std::vector<std::string> only;
+  bool quick = false;
+  ClothSweepOptions cloth;
+  FlockSweepOptions flock;
+  MemorySweepOptions memory;
+  AdjointSweepOptions adjoint;
+  int point_steps = 0, point_every = 0, point_resolution = 16;
+};
+
+// The option groups of the four sweeps.
+void add_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
   auto* c = sub->add_option_group("cloth sweep");
   c->add_option("--substeps", o->cloth.substeps, "steps per 1/30 s frame (h = 1/(30 x substeps))")
       ->capture_default_str()->delimiter(',')->check(CLI::Range(1, 1000));
@@ -74,6 +64,43 @@ void add_bench_command(CLI::App& app) {
       ->capture_default_str()->check(CLI::Range(0, 100000));
   a->add_option("--adjoint-seconds", o->adjoint.optimize_seconds, "wall time of each optimisation")
       ->capture_default_str()->check(CLI::Range(0.1, 1e6));
+}
+
+// --quick: smaller sweeps, except where an option was given explicitly.
+void apply_quick_defaults(CLI::App* sub, BenchOptions& o) {
+  auto given = [&](const std::string& name) { return sub->count(name) > 0; };
+  if (!given("--substeps")) o.cloth.substeps = {1, 4, 16};
+  if (!given("--resolutions")) o.cloth.resolutions = {16, 24, 32};
+  if (!given("--tolerances")) o.cloth.tolerances = {1e-4, 1e-6, 1e-8};
+  if (!given("--cloth-frames")) o.cloth.frames = 10;
+  if (!given("--samples")) o.cloth.gradcheck_samples = 12;
+  if (!given("--cloth-evaluations")) o.cloth.optimize_evaluations = 15;
+  if (!given("--agents")) o.flock.agents = {100, 300, 1000};
+  if (!given("--flock-frames")) o.flock.frames = 20;
+  if (!given("--flock-evaluations")) o.flock.optimize_evaluations = 6;
+  if (!given("--steps")) o.memory.steps = {500, 1000, 2000, 4000};
+  if (!given("--adjoint-frames")) o.adjoint.frames = 6;
+  if (!given("--adjoint-seconds")) o.adjoint.optimize_seconds = 10;
+}
+
+}  // namespace
+
+void add_bench_command(CLI::App& app) {
+  auto* sub = app.add_subcommand(
+      "bench",
+      "sweep speed against error: cloth (time step, resolution, PCG tolerance, per-step vs per-frame control), "
+      "flock (agents, fitted scaling exponent), memory (peak RSS against steps with and without adjoint "
+      "checkpointing), adjoint (exact against swap on the cloth figures: gradient cost and error, keyframe error "
+      "in the same wall time); writes CSV + PNG under --out");
+  auto o = std::make_shared<BenchOptions>();
+  sub->add_option("--out", o->out, "output directory")->capture_default_str();
+  sub->add_flag("--quick", o->quick,
+                "reduced sweep (a few minutes): substeps 1,4,16; n 16,24,32; tolerances 1e-4,1e-6,1e-8; agents "
+                "100,300,1000; steps 500..4000; fewer samples and evaluations. Options given explicitly win.");
+  sub->add_option("--only", o->only, "run only these sweeps")
+      ->check(CLI::IsMember({"cloth", "flock", "memory", "adjoint"}))
+      ->delimiter(',');
+  add_sweep_options(sub, o);
   // The child side of the memory sweep: one gradient in a fresh process.
   auto* hidden = sub->add_option_group("");
   hidden->add_option("--memory-point", o->point_steps);
@@ -83,21 +110,7 @@ void add_bench_command(CLI::App& app) {
       memory_point(o->point_steps, o->point_every, o->memory.resolution);
       return;
     }
-    auto given = [&](const std::string& name) { return sub->count(name) > 0; };
-    if (o->quick) {
-      if (!given("--substeps")) o->cloth.substeps = {1, 4, 16};
-      if (!given("--resolutions")) o->cloth.resolutions = {16, 24, 32};
-      if (!given("--tolerances")) o->cloth.tolerances = {1e-4, 1e-6, 1e-8};
-      if (!given("--cloth-frames")) o->cloth.frames = 10;
-      if (!given("--samples")) o->cloth.gradcheck_samples = 12;
-      if (!given("--cloth-evaluations")) o->cloth.optimize_evaluations = 15;
-      if (!given("--agents")) o->flock.agents = {100, 300, 1000};
-      if (!given("--flock-frames")) o->flock.frames = 20;
-      if (!given("--flock-evaluations")) o->flock.optimize_evaluations = 6;
-      if (!given("--steps")) o->memory.steps = {500, 1000, 2000, 4000};
-      if (!given("--adjoint-frames")) o->adjoint.frames = 6;
-      if (!given("--adjoint-seconds")) o->adjoint.optimize_seconds = 10;
-    }
+    if (o->quick) apply_quick_defaults(sub, *o);
     auto want = [&](const std::string& s) {
       return o->only.empty() || std::find(o->only.begin(), o->only.end(), s) != o->only.end();
     };

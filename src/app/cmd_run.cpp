@@ -3,12 +3,10 @@
 
 #include "app/commands.h"
 #include "app/optimize_job.h"
+#include "render/backend.h"
 #include "render/render_run.h"
 
 namespace kf {
-
-void add_optimize_options(CLI::App* sub, OptimizeOptions& o);
-void exit_if_interrupted(const OptimizeOutcome& r);
 
 void add_run_command(CLI::App& app) {
   auto* sub = app.add_subcommand("run", "optimize the scene, then render it to <run dir>/frames/frame_%04d.png");
@@ -18,7 +16,7 @@ void add_run_command(CLI::App& app) {
   sub->add_option("SCENE", *scene, "scene file (JSON)")->required();
   add_optimize_options(sub, *opts);
   sub->add_option("--backend", *backend, "renderer: osmesa (fast preview) or embree (ray traced)")
-      ->check(CLI::IsMember({"osmesa", "embree"}));
+      ->check(CLI::IsMember(render::backend_names()));
   sub->callback([=] {
     const auto outcome = optimize_job(*scene, *opts);
     exit_if_interrupted(outcome);

@@ -13,17 +13,6 @@
 
 namespace kf {
 
-Trajectory frames_of(const Rollout& r, const TimeSpec& t, int particles) {
-  Trajectory traj;
-  traj.particles = particles;
-  traj.fps = t.fps;
-  for (int n = 0; n <= r.steps(); n += t.substeps) {
-    traj.x.push_back(r.x[n]);
-    traj.v.push_back(r.v[n]);
-  }
-  return traj;
-}
-
 void add_simulate_command(CLI::App& app) {
   auto* sub = app.add_subcommand("simulate", "run the scene forward without controls and save the trajectory");
   auto scene_path = std::make_shared<std::string>();

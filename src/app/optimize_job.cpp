@@ -6,8 +6,9 @@
 #include <iostream>
 #include <sstream>
 
-#include "app/plot.h"
+#include "adjoint/rollout.h"
 #include "app/body_meshes.h"
+#include "app/plot.h"
 #include "app/run_dir.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -20,8 +21,6 @@
 
 namespace kf {
 namespace fs = std::filesystem;
-
-Trajectory frames_of(const Rollout& r, const TimeSpec& t, int particles);
 
 namespace {
 
@@ -73,6 +72,137 @@ void write_history_csv(const fs::path& path, const std::vector<HistoryRow>& rows
   write_file_atomic(path, os.str());
 }
 
+// What the job says and what it evaluates: every line goes to log.txt and, unless quiet, to stdout (a
+// quiet run shows a progress line instead); every evaluation also goes to the history (iterations.csv).
+class EvaluationLog {
+ public:
+  explicit EvaluationLog(bool quiet) : quiet_(quiet) {}
+  void say(const std::string& line) {
+    log_ << line << "\n";
+    if (!quiet_) std::cout << line << std::endl;
+  }
+  // One evaluation of stage `stage_id` (0: the only stage), run at `substeps`, after `seconds_before` seconds
+  // of earlier stages.
+  void record(int stage_id, int substeps, double seconds_before, const EvaluationRecord& r, Progress& progress) {
+    log_ << format_record(stage_id, r) << "\n";
+    if (quiet_) progress.update(r.evaluation);
+    else std::cout << format_record(stage_id, r) << std::endl;
+    history_.push_back({stage_id, substeps, seconds_before + r.seconds, r});
+  }
+  const std::vector<HistoryRow>& history() const { return history_; }
+  std::string text() const { return log_.str(); }
+
+ private:
+  bool quiet_;
+  std::ostringstream log_;
+  std::vector<HistoryRow> history_;
+};
+
+// One stage of the schedule: L-BFGS from z within spec.max_evaluations, then up to `restarts` fresh starts
+// from the best point after a stalled line search, with what is left of the budget, while they make progress.
+OptimizeResult run_stage(Problem& problem, OptimizerSpec spec, int restarts, const VecX& z, int stage_id,
+                         int substeps, double seconds_before, EvaluationLog& elog, Progress& progress) {
+  const int budget = spec.max_evaluations;
+  int used = 0;       // evaluations of the earlier starts of this stage
+  double before = 0;  // and their seconds
+  const auto on_eval = [&](const EvaluationRecord& r0) {
+    EvaluationRecord r = r0;
+    r.evaluation += used;
+    r.seconds += before;
+    elog.record(stage_id, substeps, seconds_before, r, progress);
+  };
+  OptimizeResult res = minimize(problem, spec, z, on_eval, &g_stop);
+  for (int k = 0; k < restarts && !res.interrupted; ++k) {
+    const int left = budget - int(res.history.size());
+    if (res.status.rfind("stopped: line search", 0) != 0 || left < 3) break;
+    elog.say("restart " + std::to_string(k + 1) + " from objective " + std::to_string(res.phi) + ", " +
+             std::to_string(left) + " evaluations left");
+    spec.max_evaluations = left;
+    before = res.seconds;
+    used = int(res.history.size());
+    const VecX best = res.z;
+    const double best_phi = res.phi;
+    OptimizeResult more = minimize(problem, spec, best, on_eval, &g_stop);
+    more.seconds += before;
+    more.evaluations += res.evaluations;
+    more.history.insert(more.history.begin(), res.history.begin(), res.history.end());
+    const bool progress_made = more.phi < best_phi * (1 - 1e-6);
+    if (!(more.phi < best_phi)) {  // no progress: keep the earlier best point
+      more.z = best;
+      more.phi = best_phi;
+    }
+    res = std::move(more);
+    if (!progress_made) break;  // the gradient is no descent direction here: restarting again will not help
+  }
+  return res;
+}
+
+// What the stages leave behind.
+struct JobResult {
+  VecX z;        // the best controls of the last stage
+  TimeSpec time;  // its time discretisation
+  std::unique_ptr<System> sys;
+  std::unique_ptr<Problem> problem;
+  std::string status;
+  bool interrupted = false;
+  int evaluations = 0;
+  double seconds = 0;
+};
+
+// Simulates the best point (and, for a cape blend, the uncontrolled run its end state is measured
+// against), then writes controls.bin, trajectory.bin, meshes.bin, iterations.csv, convergence.png and
+// report.json into dir.
+nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, size_t stages, bool resuming,
+                                JobResult& job, const EvaluationLog& elog) {
+  Problem& problem = *job.problem;
+  System& sys = *job.sys;
+  nlohmann::json uncontrolled_stats;
+  Trajectory uncontrolled;
+  if (scene.character) {
+    problem.evaluate(problem.initial_guess(), nullptr);
+    uncontrolled = frames_of(problem.rollout(), job.time, sys.particles());
+    for (const auto& [name, value] : sys.run_stats()) uncontrolled_stats[name] = value;
+  }
+  const double final_objective = problem.evaluate(job.z, nullptr);
+  const Trajectory frames = frames_of(problem.rollout(), job.time, sys.particles());
+  save_controls(dir / "controls.bin", job.z, job.time.substeps);
+  save_trajectory(dir / "trajectory.bin", frames);
+  write_body_meshes(scene, frames.frames(), dir / "meshes.bin");
+  const auto& history = elog.history();
+  if (!history.empty()) {
+    write_history_csv(dir / "iterations.csv", history, history.front().rec.terms);
+    plot_csv(dir / "iterations.csv", dir / "convergence.png", scene.name + ": objective and gradient norm", 1, {3, 4});
+  }
+  nlohmann::json report = {{"scene", scene.name},
+                           {"command", "optimize"},
+                           {"system", sys.describe()},
+                           {"controls", problem.controls().kind()},
+                           {"control_variables", problem.size()},
+                           {"steps", job.time.steps()},
+                           {"substeps", job.time.substeps},
+                           {"checkpoint_every", problem.checkpoint_every()},
+                           {"adjoint", scene.optimizer.adjoint},
+                           {"stages", stages},
+                           {"resumed", resuming},
+                           {"status", job.status},
+                           {"interrupted", job.interrupted},
+                           {"evaluations", job.evaluations},
+                           {"wall_seconds", job.seconds},
+                           {"initial_objective", history.empty() ? 0.0 : history.front().rec.phi},
+                           {"final_objective", final_objective},
+                           {"measures", figure_measures(scene, frames)}};
+  nlohmann::json terms = nlohmann::json::object();
+  for (const auto& [name, value] : problem.breakdown()) terms[name] = value;
+  report["final_terms"] = terms;
+  for (const auto& [name, value] : sys.run_stats()) report["run_stats"][name] = value;
+  if (scene.character) {
+    report["uncontrolled_run_stats"] = uncontrolled_stats;
+    report["cape_end_state"] = cape_end_state(scene, frames, uncontrolled);
+  }
+  write_json(dir / "report.json", report);
+  return report;
+}
+
 }  // namespace
 
 OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& opt) {
@@ -86,153 +216,61 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (stages.empty()) stages.push_back({scene.time.substeps, scene.optimizer.max_evaluations});
   if (opt.max_evaluations >= 0)
     for (auto& s : stages) s.max_evaluations = opt.max_evaluations;
-  VecX z;
+  JobResult job;
   TimeSpec z_time = scene.time;
   if (resuming) {
-    z = load_controls(dir / "controls.bin", &z_time.substeps);
+    job.z = load_controls(dir / "controls.bin", &z_time.substeps);
     stages.erase(stages.begin(), stages.end() - 1);
   }
   // Build the first system before writing anything, so bad scenes leave no trace.
-  TimeSpec time = scene.time;
+  TimeSpec& time = job.time;
+  time = scene.time;
   time.substeps = stages[0].substeps;
-  auto sys = make_system(scene, time.h());
+  job.sys = make_system(scene, time.h());
   if (!resuming) prepare_run_dir(dir, scene);
 
-  std::ostringstream log;
-  auto say = [&](const std::string& line) {
-    log << line << "\n";
-    if (!opt.quiet) std::cout << line << std::endl;
-  };
+  EvaluationLog elog(opt.quiet);
   SignalGuard signals;
-  std::vector<HistoryRow> history;
-  double seconds_before = 0;
-  int evaluations = 0;
-  std::string status;
-  bool interrupted = false;
-  std::unique_ptr<Problem> problem;
-  OptimizeResult res;
-  for (size_t s = 0; s < stages.size() && !interrupted; ++s) {
+  for (size_t s = 0; s < stages.size() && !job.interrupted; ++s) {
     time.substeps = stages[s].substeps;
-    if (s > 0) sys = make_system(scene, time.h());
-    problem = std::make_unique<Problem>(scene, time, *sys);
-    if (opt.checkpoint_every >= 0) problem->set_checkpoint_every(opt.checkpoint_every);
-    z = z.size() == 0 ? problem->initial_guess() : problem->controls().remap_from(z, z_time);
-    if (z.size() != problem->size())
+    if (s > 0) job.sys = make_system(scene, time.h());
+    job.problem = std::make_unique<Problem>(scene, time, *job.sys);
+    Problem& problem = *job.problem;
+    if (opt.checkpoint_every >= 0) problem.set_checkpoint_every(opt.checkpoint_every);
+    VecX& z = job.z;
+    z = z.size() == 0 ? problem.initial_guess() : problem.controls().remap_from(z, z_time);
+    if (z.size() != problem.size())
       throw InputError((dir / "controls.bin").string() + ": holds " + std::to_string(z.size()) +
-                       " controls, the scene needs " + std::to_string(problem->size()));
+                       " controls, the scene needs " + std::to_string(problem.size()));
     z_time = time;
     const int stage_id = stages.size() > 1 ? int(s) + 1 : 0;
-    say(std::string(resuming ? "resuming " : "optimising ") + scene.name + (stage_id ? " stage " + std::to_string(stage_id) : "") +
-        ": " + sys->describe() + ", " + std::to_string(time.steps()) + " steps (h = " + std::to_string(time.h()) +
-        " s), " + std::to_string(problem->size()) + " control variables (" + problem->controls().kind() + ")");
+    elog.say(std::string(resuming ? "resuming " : "optimising ") + scene.name +
+             (stage_id ? " stage " + std::to_string(stage_id) : "") + ": " + job.sys->describe() + ", " +
+             std::to_string(time.steps()) + " steps (h = " + std::to_string(time.h()) + " s), " +
+             std::to_string(problem.size()) + " control variables (" + problem.controls().kind() + ")");
     OptimizerSpec spec = scene.optimizer;
     spec.max_evaluations = stages[s].max_evaluations;
     Progress progress("optimize " + scene.name, spec.max_evaluations);
-    res = minimize(*problem, spec, z,
-                   [&](const EvaluationRecord& r) {
-                     // Quiet runs show a progress line; others print every evaluation.
-                     log << format_record(stage_id, r) << "\n";
-                     if (opt.quiet) progress.update(r.evaluation);
-                     else std::cout << format_record(stage_id, r) << std::endl;
-                     history.push_back({stage_id, time.substeps, seconds_before + r.seconds, r});
-                   },
-                   &g_stop);
-    // Restarts after a stalled line search, from the best point, with what is left of the stage's budget.
-    for (int k = 0; k < scene.optimizer.restarts && !res.interrupted; ++k) {
-      const int left = stages[s].max_evaluations - int(res.history.size());
-      if (res.status.rfind("stopped: line search", 0) != 0 || left < 3) break;
-      say("restart " + std::to_string(k + 1) + " from objective " + std::to_string(res.phi) + ", " +
-          std::to_string(left) + " evaluations left");
-      OptimizerSpec rest = spec;
-      rest.max_evaluations = left;
-      const double before = res.seconds;
-      const int used = int(res.history.size());
-      const VecX best = res.z;
-      const double best_phi = res.phi;
-      OptimizeResult more = minimize(*problem, rest, best,
-                                     [&](const EvaluationRecord& r0) {
-                                       EvaluationRecord r = r0;
-                                       r.evaluation += used;
-                                       r.seconds += before;
-                                       log << format_record(stage_id, r) << "\n";
-                                       if (opt.quiet) progress.update(r.evaluation);
-                                       else std::cout << format_record(stage_id, r) << std::endl;
-                                       history.push_back({stage_id, time.substeps, seconds_before + r.seconds, r});
-                                     },
-                                     &g_stop);
-      more.seconds += before;
-      more.evaluations += res.evaluations;
-      more.history.insert(more.history.begin(), res.history.begin(), res.history.end());
-      const bool progress_made = more.phi < best_phi * (1 - 1e-6);
-      if (!(more.phi < best_phi)) {  // no progress: keep the earlier best point
-        more.z = best;
-        more.phi = best_phi;
-      }
-      res = std::move(more);
-      if (!progress_made) break;  // the gradient is no descent direction here: restarting again will not help
-    }
+    const OptimizeResult res = run_stage(problem, spec, scene.optimizer.restarts, z, stage_id, time.substeps,
+                                         job.seconds, elog, progress);
     progress.finish();
     z = res.z;
-    seconds_before += res.seconds;
-    evaluations += res.evaluations;
-    status = res.status;
-    interrupted = res.interrupted;
+    job.seconds += res.seconds;
+    job.evaluations += res.evaluations;
+    job.status = res.status;
+    job.interrupted = res.interrupted;
   }
 
-  // A cape blend reports its end state against the uncontrolled run (no forces) and that run's contacts.
-  nlohmann::json uncontrolled_stats;
-  Trajectory uncontrolled;
-  if (scene.character) {
-    problem->evaluate(problem->initial_guess(), nullptr);
-    uncontrolled = frames_of(problem->rollout(), time, sys->particles());
-    for (const auto& [name, value] : sys->run_stats()) uncontrolled_stats[name] = value;
-  }
-  // Re-simulate the best point to get its states, then write everything.
-  problem->evaluate(z, nullptr);
-  const Trajectory frames = frames_of(problem->rollout(), time, sys->particles());
-  save_controls(dir / "controls.bin", z, time.substeps);
-  save_trajectory(dir / "trajectory.bin", frames);
-  write_body_meshes(scene, frames.frames(), dir / "meshes.bin");
-  if (!history.empty()) {
-    write_history_csv(dir / "iterations.csv", history, history.front().rec.terms);
-    plot_csv(dir / "iterations.csv", dir / "convergence.png", scene.name + ": objective and gradient norm", 1, {3, 4});
-  }
-  nlohmann::json report = {{"scene", scene.name},
-                           {"command", "optimize"},
-                           {"system", sys->describe()},
-                           {"controls", problem->controls().kind()},
-                           {"control_variables", problem->size()},
-                           {"steps", time.steps()},
-                           {"substeps", time.substeps},
-                           {"checkpoint_every", problem->checkpoint_every()},
-                           {"adjoint", scene.optimizer.adjoint},
-                           {"stages", stages.size()},
-                           {"resumed", resuming},
-                           {"status", status},
-                           {"interrupted", interrupted},
-                           {"evaluations", evaluations},
-                           {"wall_seconds", seconds_before},
-                           {"initial_objective", history.empty() ? 0.0 : history.front().rec.phi},
-                           {"final_objective", problem->evaluate(z, nullptr)},
-                           {"measures", figure_measures(scene, frames)}};
-  nlohmann::json terms = nlohmann::json::object();
-  for (const auto& [name, value] : problem->breakdown()) terms[name] = value;
-  report["final_terms"] = terms;
-  for (const auto& [name, value] : sys->run_stats()) report["run_stats"][name] = value;
-  if (scene.character) {
-    report["uncontrolled_run_stats"] = uncontrolled_stats;
-    report["cape_end_state"] = cape_end_state(scene, frames, uncontrolled);
-  }
-  write_json(dir / "report.json", report);
+  const nlohmann::json report = write_run_report(dir, scene, stages.size(), resuming, job, elog);
   std::ostringstream tail;
-  tail << status << " after " << evaluations << " evaluations in " << std::fixed << std::setprecision(2)
-       << seconds_before << " s; objective " << std::scientific << report["final_objective"].get<double>();
-  say(tail.str());
+  tail << job.status << " after " << job.evaluations << " evaluations in " << std::fixed << std::setprecision(2)
+       << job.seconds << " s; objective " << std::scientific << report["final_objective"].get<double>();
+  elog.say(tail.str());
   if (opt.quiet) std::cout << tail.str() << std::endl;
-  if (interrupted)
-    say("interrupted: best controls so far saved; continue with: keyframe optimize --resume " + dir.string());
-  write_file_atomic(dir / (resuming ? "log_resumed.txt" : "log.txt"), log.str());
-  return {dir, interrupted};
+  if (job.interrupted)
+    elog.say("interrupted: best controls so far saved; continue with: keyframe optimize --resume " + dir.string());
+  write_file_atomic(dir / (resuming ? "log_resumed.txt" : "log.txt"), elog.text());
+  return {dir, job.interrupted};
 }
 
 }  // namespace kf

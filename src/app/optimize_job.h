@@ -3,6 +3,10 @@
 #include <filesystem>
 #include <string>
 
+namespace CLI {
+class App;
+}
+
 namespace kf {
 
 struct OptimizeOptions {
@@ -22,5 +26,10 @@ struct OptimizeOutcome {
 // Throws InputError/OutputError. On SIGINT/SIGTERM it saves the best controls so far, writes the run
 // directory and returns with interrupted = true.
 OptimizeOutcome optimize_job(const std::filesystem::path& scene_file, const OptimizeOptions& options);
+
+// The options `optimize` and `run` share (--out, --max-evaluations, --checkpoint-every, --adjoint, --quiet).
+void add_optimize_options(CLI::App* sub, OptimizeOptions& o);
+// Exits with kExitInterrupted when the job was stopped by a signal (after it saved its run directory).
+void exit_if_interrupted(const OptimizeOutcome& r);
 
 }  // namespace kf

@@ -12,10 +12,10 @@ Controls::Controls(const ControlSpec& spec, const TimeSpec& time, int particles,
       particles_(particles),
       h_(time.h()), v0_scene_(v0_scene) {
   comps_ = planar ? std::vector<int>{0, 2} : std::vector<int>{0, 1, 2};
-  blocks_ = kind_ == "per_step" ? steps_ : kind_ == "per_frame" ? time.frames : 1;
-  if (kind_ == "initial_rigid_velocity") {
+  blocks_ = kind_ == ControlKind::kPerStep ? steps_ : kind_ == ControlKind::kPerFrame ? time.frames : 1;
+  if (kind_ == ControlKind::kInitialRigidVelocity) {
     rigid_ = true;
-    kind_ = "initial_velocity";  // everywhere else it behaves as initial-velocity control
+    kind_ = ControlKind::kInitialVelocity;  // everywhere else it behaves as initial-velocity control
     Vec3 c = Vec3::Zero();
     for (int i = 0; i < particles_; ++i) c += x0_scene.segment<3>(3 * i);
     c /= std::max(1, particles_);
@@ -48,7 +48,7 @@ void Controls::rigid_gather(const VecX& dv0, VecX& dz) const {
 
 VecX Controls::initial_guess() const {
   VecX z = VecX::Zero(size());
-  if (kind_ == "initial_velocity" && !rigid_) {
+  if (kind_ == ControlKind::kInitialVelocity && !rigid_) {
     const int nc = int(comps_.size());
     for (int i = 0; i < particles_; ++i)
       for (int c = 0; c < nc; ++c) z[i * nc + c] = v0_scene_[3 * i + comps_[c]];
@@ -65,13 +65,13 @@ void Controls::expand(const VecX& z, VecX& v0, std::vector<VecX>& U) const {
   }
   v0 = v0_scene_;
   if (rigid_) return rigid_velocity(z, v0);
-  if (kind_ == "initial_velocity") {
+  if (kind_ == ControlKind::kInitialVelocity) {
     for (int i = 0; i < particles_; ++i)
       for (int c = 0; c < nc; ++c) v0[3 * i + comps_[c]] = z[i * nc + c];
     return;
   }
   for (int n = 0; n < steps_; ++n) {
-    const int b = kind_ == "per_step" ? n : n / substeps_;
+    const int b = kind_ == ControlKind::kPerStep ? n : n / substeps_;
     for (int i = 0; i < particles_; ++i)
       for (int c = 0; c < nc; ++c) U[n][3 * i + comps_[c]] = z[b * stride + i * nc + c];
   }
@@ -81,20 +81,20 @@ void Controls::gather(const std::vector<VecX>& dU, const VecX& dv0, VecX& dz) co
   const int nc = int(comps_.size()), stride = particles_ * nc;
   dz.setZero(size());
   if (rigid_) return rigid_gather(dv0, dz);
-  if (kind_ == "initial_velocity") {
+  if (kind_ == ControlKind::kInitialVelocity) {
     for (int i = 0; i < particles_; ++i)
       for (int c = 0; c < nc; ++c) dz[i * nc + c] = dv0[3 * i + comps_[c]];
     return;
   }
   for (int n = 0; n < steps_; ++n) {
-    const int b = kind_ == "per_step" ? n : n / substeps_;
+    const int b = kind_ == ControlKind::kPerStep ? n : n / substeps_;
     for (int i = 0; i < particles_; ++i)
       for (int c = 0; c < nc; ++c) dz[b * stride + i * nc + c] += dU[n][3 * i + comps_[c]];
   }
 }
 
 VecX Controls::remap_from(const VecX& z, const TimeSpec& from) const {
-  if (kind_ != "per_step" || from.substeps == substeps_) return z;
+  if (kind_ != ControlKind::kPerStep || from.substeps == substeps_) return z;
   const int stride = particles_ * int(comps_.size());
   VecX out(size());
   for (int n = 0; n < steps_; ++n) {
@@ -108,16 +108,16 @@ void Controls::force_at(const VecX& z, int n, VecX& u) const {
   const int nc = int(comps_.size()), dof = 3 * particles_, stride = particles_ * nc;
   if (u.size() != dof) u.resize(dof);
   u.setZero();
-  if (kind_ == "initial_velocity") return;
-  const int b = kind_ == "per_step" ? n : n / substeps_;
+  if (kind_ == ControlKind::kInitialVelocity) return;
+  const int b = kind_ == ControlKind::kPerStep ? n : n / substeps_;
   for (int i = 0; i < particles_; ++i)
     for (int c = 0; c < nc; ++c) u[3 * i + comps_[c]] = z[b * stride + i * nc + c];
 }
 
 void Controls::add_step_gradient(int n, const VecX& uhat, VecX& dz) const {
-  if (kind_ == "initial_velocity") return;
+  if (kind_ == ControlKind::kInitialVelocity) return;
   const int nc = int(comps_.size()), stride = particles_ * nc;
-  const int b = kind_ == "per_step" ? n : n / substeps_;
+  const int b = kind_ == ControlKind::kPerStep ? n : n / substeps_;
   for (int i = 0; i < particles_; ++i)
     for (int c = 0; c < nc; ++c) dz[b * stride + i * nc + c] += uhat[3 * i + comps_[c]];
 }
@@ -125,7 +125,7 @@ void Controls::add_step_gradient(int n, const VecX& uhat, VecX& dz) const {
 void Controls::initial_velocity(const VecX& z, VecX& v0) const {
   const int nc = int(comps_.size());
   v0 = v0_scene_;
-  if (kind_ != "initial_velocity") return;
+  if (kind_ != ControlKind::kInitialVelocity) return;
   if (rigid_) return rigid_velocity(z, v0);
   for (int i = 0; i < particles_; ++i)
     for (int c = 0; c < nc; ++c) v0[3 * i + comps_[c]] = z[i * nc + c];
@@ -133,20 +133,20 @@ void Controls::initial_velocity(const VecX& z, VecX& v0) const {
 
 void Controls::gather_initial_velocity(const VecX& dv0, VecX& dz) const {
   const int nc = int(comps_.size());
-  if (kind_ != "initial_velocity") return;
+  if (kind_ != ControlKind::kInitialVelocity) return;
   if (rigid_) return rigid_gather(dv0, dz);
   for (int i = 0; i < particles_; ++i)
     for (int c = 0; c < nc; ++c) dz[i * nc + c] += dv0[3 * i + comps_[c]];
 }
 
 double Controls::effort(const VecX& z, VecX& dz) const {
-  if (kind_ == "initial_velocity") {
+  if (kind_ == ControlKind::kInitialVelocity) {
     const VecX d = z - initial_guess();
     dz += alpha_ * d;
     return 0.5 * alpha_ * d.squaredNorm();
   }
   // Time-integral of ‖u‖²: a frame's force acts for `substeps` steps of length h.
-  const double dt = kind_ == "per_step" ? h_ : h_ * substeps_;
+  const double dt = kind_ == ControlKind::kPerStep ? h_ : h_ * substeps_;
   dz += alpha_ * dt * z;
   return 0.5 * alpha_ * dt * z.squaredNorm();
 }

@@ -18,7 +18,7 @@ class Controls {
            const VecX& v0_scene);
 
   int size() const { return rigid_ ? 6 : blocks_ * particles_ * int(comps_.size()); }
-  const std::string& kind() const { return name_; }
+  const char* kind() const { return control_kind_name(name_); }
   // The starting point of the optimisation: no force, or the scene's initial velocities.
   VecX initial_guess() const;
   // z (size()) -> initial velocities v0 (3p) and per-step forces U (N entries of 3p, resized here).
@@ -41,7 +41,7 @@ class Controls {
   double effort(const VecX& z, VecX& dz) const;
 
  private:
-  std::string name_, kind_;  // the scene's name; how it behaves (rigid is a kind of initial_velocity)
+  ControlKind name_, kind_;  // the scene's kind; how it behaves (rigid is a kind of initial_velocity)
   double alpha_;
   int steps_, substeps_, frames_, particles_, blocks_;
   double h_;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/overloaded.h"
 #include "opt/objective_terms.h"
 #include "sim/cloth/collider.h"
 
@@ -40,99 +41,143 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
+namespace {
+
+// Each keyframe type's measures at its frame f (x = t.x[f]), added to m.
+void shape_measures(const ShapeKeyframe& k, const VecX& x, nlohmann::json& m) {
+  int inside = 0;
+  const int p = int(x.size() / 3);
+  for (int i = 0; i < p; ++i) inside += polygon_contains(k.polygon, Vec2(x[3 * i], x[3 * i + 2]));
+  const auto nn = nearest_neighbour_spacing(x);
+  m["inside_fraction"] = double(inside) / p;
+  m["min_spacing"] = *std::min_element(nn.begin(), nn.end());
+  m["median_spacing"] = median(nn);
+}
+
+void center_of_mass_measures(const Scene& scene, const ObjectiveSpec& o, const CenterOfMassKeyframe& k,
+                             const Trajectory& t, const VecX& x, nlohmann::json& m) {
+  // Path: the start's centre of mass, then every centre-of-mass target in frame order.
+  std::vector<std::pair<int, Vec3>> pts{{0, mean_of(t.x[0], o.particles)}};
+  for (const auto& q : scene.objectives)
+    if (const auto* c = std::get_if<CenterOfMassKeyframe>(&q.kind)) pts.emplace_back(q.frame, c->target);
+  std::stable_sort(pts.begin(), pts.end(), [](auto& a, auto& b) { return a.first < b.first; });
+  double length = 0;
+  for (size_t j = 1; j < pts.size(); ++j) length += (pts[j].second - pts[j - 1].second).norm();
+  const double err = (mean_of(x, o.particles) - k.target).norm();
+  m["error"] = err;
+  m["path_length"] = length;
+  m["error_over_path"] = length > 0 ? err / length : 0.0;
+}
+
+// The race: one agent of a flock from last to first along the flock's heading.
+void race_measures(const ObjectiveSpec& o, const PositionKeyframe& k, const Trajectory& t, int f, nlohmann::json& m) {
+  const VecX& x = t.x[f];
+  const int a = o.particles[0];
+  Vec3 heading = mean_of(t.x[f], {}) - mean_of(t.x[0], {});
+  if (heading.norm() < 1e-12) heading = Vec3::UnitX();
+  heading.normalize();
+  auto rank = [&](const VecX& s) {
+    const double mine = seg(s, a).dot(heading);
+    int r = 0;
+    for (int i = 0; i < s.size() / 3; ++i) r += (i != a && seg(s, i).dot(heading) < mine);
+    return r;
+  };
+  const int p = int(x.size() / 3);
+  const int r0 = rank(t.x[0]), r1 = rank(x);
+  m["rank_at_start"] = r0;
+  m["rank_at_end"] = r1;
+  m["last_at_start"] = r0 == 0;
+  m["first_at_end"] = r1 == p - 1;
+  m["rms_error"] = (seg(x, a) - k.targets[0]).norm();
+}
+
+// Sum of squared distances of the objective's particles in q (positions or velocities) to their targets.
+double target_squared_error(const ObjectiveSpec& o, const std::vector<Vec3>& targets, const VecX& q, int& n) {
+  double sum = 0;
+  n = o.particles.empty() ? int(q.size() / 3) : int(o.particles.size());
+  for (int j = 0; j < n; ++j) {
+    const int i = o.particles.empty() ? j : o.particles[j];
+    sum += (seg(q, i) - targets[targets.size() == 1 ? 0 : j]).squaredNorm();
+  }
+  return sum;
+}
+
+void position_measures(const Scene& scene, const ObjectiveSpec& o, const PositionKeyframe& k, const Trajectory& t,
+                       int f, nlohmann::json& m) {
+  if (scene.flock && o.particles.size() == 1) return race_measures(o, k, t, f, m);
+  int n = 0;
+  const double sum = target_squared_error(o, k.targets, t.x[f], n);
+  m["rms_error"] = std::sqrt(sum / n);
+  if (scene.cloth) {
+    const double width = (seg(t.x[0], scene.cloth->nx - 1) - seg(t.x[0], 0)).norm();
+    m["rms_over_width"] = width > 0 ? std::sqrt(sum / n) / width : 0.0;
+  }
+}
+
+void arch_measures(const Scene& scene, const ArchKeyframe& k, const Trajectory& t, const VecX& x, nlohmann::json& m) {
+  double sum = 0;
+  const int p = int(x.size() / 3);
+  for (int i = 0; i < p; ++i) {
+    const Vec3 d = seg(x, i) - k.axis_point;
+    const double e = (d - d.dot(k.axis) * k.axis).norm() - k.radius;
+    sum += e * e;
+  }
+  const int nx = scene.cloth ? scene.cloth->nx : 1;
+  const double width = (seg(t.x[0], nx - 1) - seg(t.x[0], 0)).norm();
+  m["rms_distance"] = std::sqrt(sum / p);
+  m["width"] = width;
+  m["rms_over_width"] = width > 0 ? std::sqrt(sum / p) / width : 0.0;
+}
+
+}  // namespace
+
 nlohmann::json figure_measures(const Scene& scene, const Trajectory& t) {
   nlohmann::json out = nlohmann::json::array();
   const int last = t.frames() - 1;
   for (const auto& o : scene.objectives) {
     const int f = std::min(o.frame, last);
     const VecX& x = t.x[f];
-    nlohmann::json m = {{"type", o.type}, {"frame", o.frame}};
-    if (o.type == "shape") {
-      int inside = 0;
-      const int p = int(x.size() / 3);
-      for (int i = 0; i < p; ++i) inside += polygon_contains(o.polygon, Vec2(x[3 * i], x[3 * i + 2]));
-      const auto nn = nearest_neighbour_spacing(x);
-      m["inside_fraction"] = double(inside) / p;
-      m["min_spacing"] = *std::min_element(nn.begin(), nn.end());
-      m["median_spacing"] = median(nn);
-    } else if (o.type == "center_of_mass") {
-      // Path: the start's centre of mass, then every centre-of-mass target in frame order.
-      std::vector<std::pair<int, Vec3>> pts{{0, mean_of(t.x[0], o.particles)}};
-      for (const auto& q : scene.objectives)
-        if (q.type == "center_of_mass") pts.emplace_back(q.frame, q.targets[0]);
-      std::stable_sort(pts.begin(), pts.end(), [](auto& a, auto& b) { return a.first < b.first; });
-      double length = 0;
-      for (size_t k = 1; k < pts.size(); ++k) length += (pts[k].second - pts[k - 1].second).norm();
-      const double err = (mean_of(x, o.particles) - o.targets[0]).norm();
-      m["error"] = err;
-      m["path_length"] = length;
-      m["error_over_path"] = length > 0 ? err / length : 0.0;
-    } else if (o.type == "position" && scene.flock && o.particles.size() == 1) {
-      const int a = o.particles[0];
-      Vec3 heading = mean_of(t.x[f], {}) - mean_of(t.x[0], {});
-      if (heading.norm() < 1e-12) heading = Vec3::UnitX();
-      heading.normalize();
-      auto rank = [&](const VecX& s) {
-        const double mine = seg(s, a).dot(heading);
-        int r = 0;
-        for (int i = 0; i < s.size() / 3; ++i) r += (i != a && seg(s, i).dot(heading) < mine);
-        return r;
-      };
-      const int p = int(x.size() / 3);
-      const int r0 = rank(t.x[0]), r1 = rank(x);
-      m["rank_at_start"] = r0;
-      m["rank_at_end"] = r1;
-      m["last_at_start"] = r0 == 0;
-      m["first_at_end"] = r1 == p - 1;
-      m["rms_error"] = (seg(x, a) - o.targets[0]).norm();
-    } else if (o.type == "position" || o.type == "velocity") {
-      const VecX& q = o.type == "position" ? x : t.v[f];
-      double sum = 0;
-      const int n = o.particles.empty() ? int(q.size() / 3) : int(o.particles.size());
-      for (int k = 0; k < n; ++k) {
-        const int i = o.particles.empty() ? k : o.particles[k];
-        sum += (seg(q, i) - o.targets[o.targets.size() == 1 ? 0 : k]).squaredNorm();
-      }
-      m["rms_error"] = std::sqrt(sum / n);
-      if (scene.cloth && o.type == "position") {
-        const double width = (seg(t.x[0], scene.cloth->nx - 1) - seg(t.x[0], 0)).norm();
-        m["rms_over_width"] = width > 0 ? std::sqrt(sum / n) / width : 0.0;
-      }
-    } else if (o.type == "arch") {
-      double sum = 0;
-      const int p = int(x.size() / 3);
-      for (int i = 0; i < p; ++i) {
-        const Vec3 d = seg(x, i) - o.axis_point;
-        const double e = (d - d.dot(o.axis) * o.axis).norm() - o.radius;
-        sum += e * e;
-      }
-      const int nx = scene.cloth ? scene.cloth->nx : 1;
-      const double width = (seg(t.x[0], nx - 1) - seg(t.x[0], 0)).norm();
-      m["rms_distance"] = std::sqrt(sum / p);
-      m["width"] = width;
-      m["rms_over_width"] = width > 0 ? std::sqrt(sum / p) / width : 0.0;
-    }
+    nlohmann::json m = {{"type", type_name(o)}, {"frame", o.frame}};
+    std::visit(Overloaded{
+                   [&](const PositionKeyframe& k) { position_measures(scene, o, k, t, f, m); },
+                   [&](const VelocityKeyframe& k) {
+                     int n = 0;
+                     m["rms_error"] = std::sqrt(target_squared_error(o, k.targets, t.v[f], n) / n);
+                   },
+                   [&](const CenterOfMassKeyframe& k) { center_of_mass_measures(scene, o, k, t, x, m); },
+                   [&](const ShapeKeyframe& k) { shape_measures(k, x, m); },
+                   [&](const ArchKeyframe& k) { arch_measures(scene, k, t, x, m); },
+               },
+               o.kind);
     out.push_back(m);
   }
-  if (scene.cloth)
-    for (size_t k = 0; k < scene.cloth->colliders.size(); ++k)
-      if (scene.cloth->colliders[k].type == "torus") {
-        nlohmann::json m = ring_measures(scene.cloth->colliders[k], t);
-        m["collider"] = int(k);
-        out.push_back(m);
-      }
+  // Then the system's own measures.
+  visit_system(scene, Overloaded{
+                          [](const FlockSpec&) {},
+                          [&](const ClothSpec& cloth) {
+                            for (size_t k = 0; k < cloth.colliders.size(); ++k)
+                              if (const auto* torus = std::get_if<TorusShape>(&cloth.colliders[k].shape)) {
+                                nlohmann::json m = ring_measures(*torus, t);
+                                m["collider"] = int(k);
+                                out.push_back(m);
+                              }
+                          },
+                      });
   return out;
 }
 
 nlohmann::json cape_end_state(const Scene& scene, const Trajectory& run, const Trajectory& uncontrolled) {
   if (!scene.character || !scene.cloth || scene.character->target_run.empty()) return nlohmann::json();
-  // The end target is the last position and velocity objective pair the character block appended.
+  // The end target: the position and velocity keyframes the character block appended.
   const ObjectiveSpec *pos = nullptr, *vel = nullptr;
   for (const auto& o : scene.objectives) {
-    if (o.type == "position" && o.targets.size() > 1) pos = &o;
-    if (o.type == "velocity" && o.targets.size() > 1) vel = &o;
+    if (o.source != ObjectiveSource::kEndTarget) continue;
+    if (std::holds_alternative<PositionKeyframe>(o.kind)) pos = &o;
+    if (std::holds_alternative<VelocityKeyframe>(o.kind)) vel = &o;
   }
   if (!pos || !vel) return nlohmann::json();
+  const auto& pos_targets = std::get<PositionKeyframe>(pos->kind).targets;
+  const auto& vel_targets = std::get<VelocityKeyframe>(vel->kind).targets;
   const double length = scene.cloth->height;
   auto rms = [](const VecX& q, const std::vector<Vec3>& t) {
     double sum = 0;
@@ -141,16 +186,16 @@ nlohmann::json cape_end_state(const Scene& scene, const Trajectory& run, const T
   };
   auto of = [&](const Trajectory& t) {
     const int f = std::min(pos->frame, t.frames() - 1);
-    const double ex = rms(t.x[f], pos->targets);
+    const double ex = rms(t.x[f], pos_targets);
     return nlohmann::json{{"rms_position_error", ex},
                           {"rms_position_error_percent", 100.0 * ex / length},
-                          {"rms_velocity_error", rms(t.v[std::min(vel->frame, t.frames() - 1)], vel->targets)}};
+                          {"rms_velocity_error", rms(t.v[std::min(vel->frame, t.frames() - 1)], vel_targets)}};
   };
   return {{"frame", pos->frame}, {"cape_length", length}, {"controlled", of(run)}, {"uncontrolled", of(uncontrolled)}};
 }
 
-nlohmann::json ring_measures(const ColliderSpec& torus, const Trajectory& t) {
-  const TorusCollider ring(torus, 0.0);  // distances only
+nlohmann::json ring_measures(const TorusShape& torus, const Trajectory& t) {
+  const TorusCollider ring(torus, 0.0, 0.0, 0.0);  // distances only
   const Vec3 axis = torus.axis.normalized();
   const double inner = torus.radius - torus.tube_radius;
   double min_phi = std::numeric_limits<double>::infinity();

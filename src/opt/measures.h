@@ -29,7 +29,7 @@ nlohmann::json figure_measures(const Scene& scene, const Trajectory& frames);
 nlohmann::json cape_end_state(const Scene& scene, const Trajectory& run, const Trajectory& uncontrolled);
 
 // Ring measures of one torus collider over the frames of a run (the "ring" object described above).
-nlohmann::json ring_measures(const ColliderSpec& torus, const Trajectory& frames);
+nlohmann::json ring_measures(const TorusShape& torus, const Trajectory& frames);
 
 // Nearest-neighbour distance of each particle in the ground plane (x, z) at one state.
 std::vector<double> nearest_neighbour_spacing(const VecX& x);

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/overloaded.h"
+
 namespace kf {
 
 bool polygon_contains(const std::vector<Vec2>& poly, const Vec2& q) {
@@ -52,8 +54,8 @@ std::vector<int> members(const ObjectiveSpec& s, int particles) {
 // ½w Σ‖x_i − t_i‖² (position) or ½w Σ‖v_i − t_i‖² (velocity).
 class KeyframeTerm : public ObjectiveTerm {
  public:
-  KeyframeTerm(const ObjectiveSpec& s, int p, bool on_velocity)
-      : frame_(s.frame), w_(s.weight), ids_(members(s, p)), targets_(s.targets), on_velocity_(on_velocity) {}
+  KeyframeTerm(const ObjectiveSpec& s, const std::vector<Vec3>& targets, int p, bool on_velocity)
+      : frame_(s.frame), w_(s.weight), ids_(members(s, p)), targets_(targets), on_velocity_(on_velocity) {}
   std::string name() const override { return on_velocity_ ? "velocity" : "position"; }
   int frame() const override { return frame_; }
   double eval(const VecX& x, const VecX& v, VecX& gx, VecX& gv) const override {
@@ -79,8 +81,8 @@ class KeyframeTerm : public ObjectiveTerm {
 // ½w‖x̄ − c‖² with x̄ the mean position of the members.
 class CenterOfMassTerm : public ObjectiveTerm {
  public:
-  CenterOfMassTerm(const ObjectiveSpec& s, int p)
-      : frame_(s.frame), w_(s.weight), ids_(members(s, p)), target_(s.targets.at(0)) {}
+  CenterOfMassTerm(const ObjectiveSpec& s, const CenterOfMassKeyframe& k, int p)
+      : frame_(s.frame), w_(s.weight), ids_(members(s, p)), target_(k.target) {}
   std::string name() const override { return "center_of_mass"; }
   int frame() const override { return frame_; }
   double eval(const VecX& x, const VecX&, VecX& gx, VecX&) const override {
@@ -106,8 +108,8 @@ class CenterOfMassTerm : public ObjectiveTerm {
 // boundary (∇s is the unit direction away from the closest boundary point, outward).
 class ShapeTerm : public ObjectiveTerm {
  public:
-  ShapeTerm(const ObjectiveSpec& s, int p)
-      : frame_(s.frame), w_(s.weight), margin_(s.margin), ids_(members(s, p)), poly_(s.polygon) {}
+  ShapeTerm(const ObjectiveSpec& s, const ShapeKeyframe& k, int p)
+      : frame_(s.frame), w_(s.weight), margin_(k.margin), ids_(members(s, p)), poly_(k.polygon) {}
   std::string name() const override { return "shape"; }
   int frame() const override { return frame_; }
   double eval(const VecX& x, const VecX&, VecX& gx, VecX&) const override {
@@ -148,8 +150,8 @@ class ShapeTerm : public ObjectiveTerm {
 // ½w Σ (‖r⊥_i‖ − R)², r⊥ the offset of x_i from the cylinder axis: cloth onto an arch.
 class ArchTerm : public ObjectiveTerm {
  public:
-  ArchTerm(const ObjectiveSpec& s, int p)
-      : frame_(s.frame), w_(s.weight), ids_(members(s, p)), a_(s.axis_point), e_(s.axis), r_(s.radius) {}
+  ArchTerm(const ObjectiveSpec& s, const ArchKeyframe& k, int p)
+      : frame_(s.frame), w_(s.weight), ids_(members(s, p)), a_(k.axis_point), e_(k.axis), r_(k.radius) {}
   std::string name() const override { return "arch"; }
   int frame() const override { return frame_; }
   double eval(const VecX& x, const VecX&, VecX& gx, VecX&) const override {
@@ -177,12 +179,16 @@ class ArchTerm : public ObjectiveTerm {
 }  // namespace
 
 std::unique_ptr<ObjectiveTerm> make_objective_term(const ObjectiveSpec& s, int particles) {
-  if (s.type == "position") return std::make_unique<KeyframeTerm>(s, particles, false);
-  if (s.type == "velocity") return std::make_unique<KeyframeTerm>(s, particles, true);
-  if (s.type == "center_of_mass") return std::make_unique<CenterOfMassTerm>(s, particles);
-  if (s.type == "shape") return std::make_unique<ShapeTerm>(s, particles);
-  if (s.type == "arch") return std::make_unique<ArchTerm>(s, particles);
-  throw std::invalid_argument("unknown objective type " + s.type);
+  using Term = std::unique_ptr<ObjectiveTerm>;
+  return std::visit(
+      Overloaded{
+          [&](const PositionKeyframe& k) -> Term { return std::make_unique<KeyframeTerm>(s, k.targets, particles, false); },
+          [&](const VelocityKeyframe& k) -> Term { return std::make_unique<KeyframeTerm>(s, k.targets, particles, true); },
+          [&](const CenterOfMassKeyframe& k) -> Term { return std::make_unique<CenterOfMassTerm>(s, k, particles); },
+          [&](const ShapeKeyframe& k) -> Term { return std::make_unique<ShapeTerm>(s, k, particles); },
+          [&](const ArchKeyframe& k) -> Term { return std::make_unique<ArchTerm>(s, k, particles); },
+      },
+      s.kind);
 }
 
 }  // namespace kf

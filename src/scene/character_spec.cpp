@@ -76,16 +76,12 @@ CharacterSpec parse_character_spec(Block b, Scene& scene) {
     VecX x, v;
     load_run_state(*end, c.target_run, c.target_frame, p, x, v);
     end->finish();
-    ObjectiveSpec o;
-    o.frame = scene.time.frames;
-    for (int i = 0; i < p; ++i) o.targets.push_back(seg(x, i));
-    o.type = "position";
-    o.weight = wx;
-    scene.objectives.push_back(o);
-    o.type = "velocity";
-    o.weight = wv;
-    for (int i = 0; i < p; ++i) o.targets[i] = seg(v, i);
-    scene.objectives.push_back(o);
+    PositionKeyframe position;
+    VelocityKeyframe velocity;
+    for (int i = 0; i < p; ++i) position.targets.push_back(seg(x, i)), velocity.targets.push_back(seg(v, i));
+    const int last = scene.time.frames;
+    scene.objectives.push_back({std::move(position), last, wx, {}, ObjectiveSource::kEndTarget});
+    scene.objectives.push_back({std::move(velocity), last, wv, {}, ObjectiveSource::kEndTarget});
   }
   b.finish();
   return c;

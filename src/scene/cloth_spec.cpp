@@ -19,16 +19,58 @@ Vec3 unit_vec3(Block& b, const std::string& key, const Vec3& def) {
   return a.normalized();
 }
 
+// Each shape reads its own keys; the table below names the shapes the scene file may use.
+ColliderShape parse_ground(Block& b) {
+  GroundShape g;
+  g.point = b.vec3("center", g.point);
+  g.normal = unit_vec3(b, "axis", g.normal);
+  return g;
+}
+
+ColliderShape parse_sphere(Block& b) {
+  SphereShape s;
+  s.center = b.vec3("center", s.center);
+  s.radius = b.number("radius", s.radius, 1e-4, 1e4);
+  return s;
+}
+
+ColliderShape parse_torus(Block& b) {
+  TorusShape t;
+  t.center = b.vec3("center", t.center);
+  t.axis = unit_vec3(b, "axis", t.axis);
+  t.radius = b.number("radius", t.radius, 1e-4, 1e4);
+  t.tube_radius = b.number("tube_radius", t.tube_radius, 1e-5, 1e4);
+  if (t.tube_radius >= t.radius) b.fail("tube_radius", "expected less than \"radius\" (a ring, not a spindle torus)");
+  return t;
+}
+
+ColliderShape parse_capsule(Block& b) {
+  CapsuleShape c;
+  c.a = b.vec3("a", c.a);
+  c.b = b.vec3("b", c.b);
+  if ((c.b - c.a).norm() < 1e-6) b.fail("b", "expected a point away from \"a\" (the capsule's axis)");
+  c.radius = b.number("radius", c.radius, 1e-4, 1e4);
+  return c;
+}
+
+struct ColliderType {
+  const char* name;
+  ColliderShape (*parse)(Block&);
+};
+const ColliderType kColliderTypes[] = {
+    {GroundShape::kName, parse_ground},
+    {SphereShape::kName, parse_sphere},
+    {TorusShape::kName, parse_torus},
+    {CapsuleShape::kName, parse_capsule},
+};
+
 ColliderSpec parse_collider(Block b) {
+  std::vector<std::string> names;
+  for (const ColliderType& t : kColliderTypes) names.push_back(t.name);
+  const std::string type = b.string("type", names);
   ColliderSpec c;
-  c.type = b.string("type", {"ground", "sphere", "torus"});
-  c.center = b.vec3("center", c.center);
-  if (c.type == "ground" || c.type == "torus") c.axis = unit_vec3(b, "axis", c.axis);
-  if (c.type == "sphere" || c.type == "torus") c.radius = b.number("radius", c.radius, 1e-4, 1e4);
-  if (c.type == "torus") {
-    c.tube_radius = b.number("tube_radius", c.tube_radius, 1e-5, 1e4);
-    if (c.tube_radius >= c.radius) b.fail("tube_radius", "expected less than \"radius\" (a ring, not a spindle torus)");
-  }
+  for (const ColliderType& t : kColliderTypes)
+    if (type == t.name) c.shape = t.parse(b);
   c.thickness = b.number("thickness", c.thickness, 1e-6, 10.0);
   c.stiffness = b.number("stiffness", c.stiffness, 0.0, 1e9);
   b.finish();

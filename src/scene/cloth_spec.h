@@ -4,6 +4,8 @@
 // index j*nx + i. Named edges are by index: "bottom" is j = 0, "top" is j = ny-1, "left" is i = 0,
 // "right" is i = nx-1 (so with v_axis = +Y the top edge is the highest row).
 #include <string>
+#include <type_traits>
+#include <variant>
 #include <vector>
 
 #include "core/types.h"
@@ -11,16 +13,48 @@
 namespace kf {
 class Block;
 
+// Collider shapes, one struct each with its scene-file name; parsed through one table (cloth_spec.cpp) and
+// consumed with std::visit (its collider in sim/cloth/collider.cpp, its drawing in
+// render/geometry/frame_geometry.cpp). See src/README.md.
+struct GroundShape {
+  static constexpr const char* kName = "ground";
+  Vec3 point = Vec3::Zero();    // a point on the plane
+  Vec3 normal = Vec3::UnitY();  // unit, pointing to the free side
+};
+struct SphereShape {
+  static constexpr const char* kName = "sphere";
+  Vec3 center = Vec3::Zero();
+  double radius = 0.5;  // metres
+};
+// A ring: the tube of radius tube_radius around a circle of radius `radius` about `axis`.
+struct TorusShape {
+  static constexpr const char* kName = "torus";
+  Vec3 center = Vec3::Zero();
+  Vec3 axis = Vec3::UnitY();  // symmetry axis (unit)
+  double radius = 0.5;        // major radius (centre of the tube), metres
+  double tube_radius = 0.05;  // minor radius, metres (less than radius)
+};
+// A rod with round ends: the points within `radius` of the segment from a to b.
+struct CapsuleShape {
+  static constexpr const char* kName = "capsule";
+  Vec3 a = Vec3::Zero();    // one end of the axis segment, metres
+  Vec3 b = Vec3::UnitX();   // the other end (distinct from a)
+  double radius = 0.1;      // metres
+};
+
+using ColliderShape = std::variant<GroundShape, SphereShape, TorusShape, CapsuleShape>;
+
 // A collider the cloth is pushed out of by stiff springs inside `thickness`.
 struct ColliderSpec {
-  std::string type;              // "ground" | "sphere" | "torus"
-  Vec3 center = Vec3::Zero();    // sphere, torus centre; ground: a point on the plane
-  Vec3 axis = Vec3::UnitY();     // ground normal; torus symmetry axis (unit)
-  double radius = 0.5;           // sphere radius; torus major radius (centre of tube)
-  double tube_radius = 0.05;     // torus minor radius
-  double thickness = 0.01;       // contact springs act within this distance of the surface
-  double stiffness = 1e4;        // N/m
+  ColliderShape shape;
+  double thickness = 0.01;  // contact springs act within this distance of the surface (m)
+  double stiffness = 1e4;   // N/m
 };
+
+// The scene-file name of the collider's shape ("ground", ...).
+inline const char* type_name(const ColliderSpec& c) {
+  return std::visit([](const auto& s) { return std::decay_t<decltype(s)>::kName; }, c.shape);
+}
 
 struct ClothSpec {
   int nx = 16, ny = 16;
@@ -51,6 +85,8 @@ struct ClothSpec {
   std::vector<ColliderSpec> colliders;
 
   int particles() const { return nx * ny; }
+  bool direct_solver() const { return solver == "direct"; }
+  bool block_jacobi() const { return cg_preconditioner == "block_jacobi"; }
   int index(int i, int j) const { return j * nx + i; }
 };
 

@@ -1,30 +1,77 @@
 #pragma once
 // Keyframes and other objective terms as the scene file states them (validated, not yet evaluated).
 #include <string>
+#include <type_traits>
+#include <variant>
 #include <vector>
 
 #include "core/types.h"
 
 namespace kf {
 
-struct ObjectiveSpec {
-  // "position", "velocity": per-particle targets; "center_of_mass": one target for the group;
-  // "shape": agents outside a ground polygon (x, z) are pulled to it; "arch": cloth onto a cylinder.
-  std::string type;
-  int frame = 0;           // keyframe (frame index, 0..frames)
-  double weight = 1.0;
-  std::vector<int> particles;   // empty: all particles
-  std::vector<Vec3> targets;    // position/velocity: one per listed particle (or one for all); com: one
-  std::vector<Vec2> polygon;    // shape: closed polygon on the ground, (x, z), metres
-  double margin = 0;            // shape: agents are pulled at least this far inside (m)
-  Vec3 axis_point = Vec3::Zero();  // arch: a point on the cylinder axis
-  Vec3 axis = Vec3::UnitZ();       // arch: unit axis direction
-  double radius = 1.0;             // arch: cylinder radius, metres
+// One struct a keyframe type, each with its scene-file name; parsed through one table (scene.cpp) and
+// consumed with std::visit, so a new type is named by the compiler at every site that must handle it
+// (its objective term, its figure measures, its drawing). See src/README.md.
+
+// ½w Σ‖x_i − t_i‖² over the listed particles (all when none are listed).
+struct PositionKeyframe {
+  static constexpr const char* kName = "position";
+  std::vector<Vec3> targets;  // metres: one per listed particle, or one for all
+};
+// ½w Σ‖v_i − t_i‖².
+struct VelocityKeyframe {
+  static constexpr const char* kName = "velocity";
+  std::vector<Vec3> targets;  // m/s: one per listed particle, or one for all
+};
+// ½w‖x̄ − c‖², x̄ the mean position of the listed particles.
+struct CenterOfMassKeyframe {
+  static constexpr const char* kName = "center_of_mass";
+  Vec3 target = Vec3::Zero();  // metres
+};
+// Flocks: agents outside a ground polygon (x, z) are pulled to at least `margin` inside it.
+struct ShapeKeyframe {
+  static constexpr const char* kName = "shape";
+  std::vector<Vec2> polygon;  // closed polygon on the ground, (x, z), metres
+  double margin = 0;          // metres
+};
+// Cloth: particles pulled onto a cylinder (an arch).
+struct ArchKeyframe {
+  static constexpr const char* kName = "arch";
+  Vec3 axis_point = Vec3::Zero();  // a point on the cylinder axis
+  Vec3 axis = Vec3::UnitZ();       // unit axis direction
+  double radius = 1.0;             // cylinder radius, metres
 };
 
+using ObjectiveKind = std::variant<PositionKeyframe, VelocityKeyframe, CenterOfMassKeyframe, ShapeKeyframe, ArchKeyframe>;
+
+// Where an objective came from: the scene's "objectives" array, or a block that adds its own (the
+// character's "end_target" appends a position and a velocity keyframe at the last frame).
+enum class ObjectiveSource { kScene, kEndTarget };
+
+struct ObjectiveSpec {
+  ObjectiveKind kind;
+  int frame = 0;                // keyframe (frame index, 0..frames)
+  double weight = 1.0;
+  std::vector<int> particles;   // empty: all particles
+  ObjectiveSource source = ObjectiveSource::kScene;
+};
+
+// The scene-file name of the objective's type ("position", ...).
+inline const char* type_name(const ObjectiveSpec& o) {
+  return std::visit([](const auto& k) { return std::decay_t<decltype(k)>::kName; }, o.kind);
+}
+
+// The control parameterisation (scene key controls.kind, named as in the scene file by control_kind_name).
+enum class ControlKind { kPerStep, kPerFrame, kInitialVelocity, kInitialRigidVelocity };
+
+inline const char* control_kind_name(ControlKind k) {
+  constexpr const char* kNames[] = {"per_step", "per_frame", "initial_velocity", "initial_rigid_velocity"};
+  return kNames[int(k)];
+}
+
 struct ControlSpec {
-  std::string kind = "per_step";  // "per_step" | "per_frame" | "initial_velocity" | "initial_rigid_velocity"
-  double alpha = 1e-4;            // weight of the control effort ½α‖u‖²
+  ControlKind kind = ControlKind::kPerStep;
+  double alpha = 1e-4;  // weight of the control effort ½α‖u‖²
 };
 
 // One stage of coarse-to-fine continuation: optimise at this many substeps per frame.

@@ -28,43 +28,83 @@ TimeSpec parse_time(Block b) {
   return t;
 }
 
+// Each keyframe type reads its own keys; the table below names the types the scene file may use.
+std::vector<Vec3> parse_targets(Block& b, const ObjectiveSpec& o, int particles) {
+  std::vector<Vec3> targets = b.points3("targets", 1);
+  const size_t n = o.particles.empty() ? size_t(particles) : o.particles.size();
+  if (targets.size() != 1 && targets.size() != n)
+    b.fail("targets", "expected 1 target or one per particle (" + std::to_string(n) + "), got " +
+                          std::to_string(targets.size()));
+  return targets;
+}
+
+ObjectiveKind parse_position(Block& b, const ObjectiveSpec& o, const Scene& s) {
+  return PositionKeyframe{parse_targets(b, o, s.particles())};
+}
+
+ObjectiveKind parse_velocity(Block& b, const ObjectiveSpec& o, const Scene& s) {
+  return VelocityKeyframe{parse_targets(b, o, s.particles())};
+}
+
+ObjectiveKind parse_center_of_mass(Block& b, const ObjectiveSpec&, const Scene&) {
+  return CenterOfMassKeyframe{b.vec3("target")};
+}
+
+ObjectiveKind parse_shape(Block& b, const ObjectiveSpec&, const Scene& s) {
+  if (!s.flock) b.fail("type", "\"shape\" keyframes are for flocks; use \"position\" or \"arch\" for cloth");
+  ShapeKeyframe k;
+  k.polygon = b.points2("polygon", 3);
+  k.margin = b.number("margin", 0.0, 0.0, 1e4);
+  return k;
+}
+
+ObjectiveKind parse_arch(Block& b, const ObjectiveSpec&, const Scene& s) {
+  if (s.flock) b.fail("type", "\"arch\" keyframes are for cloth");
+  ArchKeyframe k;
+  k.axis_point = b.vec3("axis_point");
+  k.axis = b.vec3("axis", Vec3::UnitZ(), -1e3, 1e3);
+  if (k.axis.norm() < 1e-9) b.fail("axis", "expected a non-zero direction");
+  k.axis.normalize();
+  k.radius = b.number("radius", 1e-4, 1e4);
+  return k;
+}
+
+struct ObjectiveType {
+  const char* name;
+  ObjectiveKind (*parse)(Block&, const ObjectiveSpec&, const Scene&);
+};
+const ObjectiveType kObjectiveTypes[] = {
+    {PositionKeyframe::kName, parse_position},         {VelocityKeyframe::kName, parse_velocity},
+    {CenterOfMassKeyframe::kName, parse_center_of_mass}, {ShapeKeyframe::kName, parse_shape},
+    {ArchKeyframe::kName, parse_arch},
+};
+
 ObjectiveSpec parse_objective(Block b, const Scene& s) {
+  std::vector<std::string> names;
+  for (const ObjectiveType& t : kObjectiveTypes) names.push_back(t.name);
   ObjectiveSpec o;
-  const bool flock = s.flock.has_value();
-  o.type = b.string("type", {"position", "velocity", "center_of_mass", "shape", "arch"});
+  const std::string type = b.string("type", names);
   o.frame = b.integer("frame", 0, s.time.frames);
   o.weight = b.number("weight", 1.0, 0.0, 1e12);
   const int p = s.particles();
   if (b.has("particles")) {
     o.particles = b.integers("particles", 1, 0, p - 1);
   }
-  if (o.type == "position" || o.type == "velocity") {
-    o.targets = b.points3("targets", 1);
-    const size_t n = o.particles.empty() ? size_t(p) : o.particles.size();
-    if (o.targets.size() != 1 && o.targets.size() != n)
-      b.fail("targets", "expected 1 target or one per particle (" + std::to_string(n) + "), got " +
-                            std::to_string(o.targets.size()));
-  } else if (o.type == "center_of_mass") {
-    o.targets = {b.vec3("target")};
-  } else if (o.type == "shape") {
-    if (!flock) b.fail("type", "\"shape\" keyframes are for flocks; use \"position\" or \"arch\" for cloth");
-    o.polygon = b.points2("polygon", 3);
-    o.margin = b.number("margin", 0.0, 0.0, 1e4);
-  } else if (o.type == "arch") {
-    if (flock) b.fail("type", "\"arch\" keyframes are for cloth");
-    o.axis_point = b.vec3("axis_point");
-    o.axis = b.vec3("axis", Vec3::UnitZ(), -1e3, 1e3);
-    if (o.axis.norm() < 1e-9) b.fail("axis", "expected a non-zero direction");
-    o.axis.normalize();
-    o.radius = b.number("radius", 1e-4, 1e4);
-  }
+  for (const ObjectiveType& t : kObjectiveTypes)
+    if (type == t.name) o.kind = t.parse(b, o, s);
   b.finish();
   return o;
 }
 
 ControlSpec parse_controls(Block b, const Scene& s) {
   ControlSpec c;
-  c.kind = b.string("kind", c.kind, {"per_step", "per_frame", "initial_velocity", "initial_rigid_velocity"});
+  const ControlKind kinds[] = {ControlKind::kPerStep, ControlKind::kPerFrame, ControlKind::kInitialVelocity,
+                               ControlKind::kInitialRigidVelocity};
+  std::vector<std::string> names;
+  for (ControlKind k : kinds) names.push_back(control_kind_name(k));
+  const std::string kind = b.string("kind", control_kind_name(c.kind), names);
+  for (ControlKind k : kinds)
+    if (kind == control_kind_name(k)) c.kind = k;
   c.alpha = b.number("alpha", c.alpha, 0.0, 1e6);
   b.finish();
   return c;

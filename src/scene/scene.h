@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "core/check.h"
 #include "scene/character_spec.h"
 #include "scene/cloth_spec.h"
 #include "scene/flock_spec.h"
@@ -29,6 +30,17 @@ struct Scene {
   std::optional<CharacterSpec> character;  // a cape's character (cloth scenes only)
   int particles() const;
 };
+
+// Calls f with the scene's particle system, its FlockSpec or its ClothSpec (a cape is a cloth with a
+// character), and returns what f returns. This is the one place that knows which member holds the
+// system: sites that treat the kinds differently visit with Overloaded{...} (core/overloaded.h), so a new
+// kind (a member above and a branch here) is a compile error at each of them until it is handled.
+template <class F>
+decltype(auto) visit_system(const Scene& scene, F&& f) {
+  CHECK(scene.flock.has_value() != scene.cloth.has_value());
+  if (scene.flock) return f(*scene.flock);
+  return f(*scene.cloth);
+}
 
 // Loads and validates a scene file. Throws InputError with "file: /pointer: expected ..." on any problem.
 Scene load_scene(const std::filesystem::path& file);

@@ -125,8 +125,7 @@ TEST(ClothFigures, RingTossPassesThroughTheRingWithoutPenetrating) {
 
 TEST(ClothFigures, RingMeasuresSeeAMissAndAPenetration) {
   // Two hand-made frames: a single particle crosses the ring's plane inside the tube, then near the axis.
-  ColliderSpec torus;
-  torus.type = "torus";
+  TorusShape torus;
   torus.axis = Vec3::UnitX();
   torus.radius = 0.3;
   torus.tube_radius = 0.03;

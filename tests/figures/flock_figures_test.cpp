@@ -183,12 +183,10 @@ TEST(FlockFigures, GradientOfTwentyAgentsOverSixtySteps) {
 }
 
 TEST(ShapeTerm, MarginGradientMatchesFiniteDifferencesInsideAndOutside) {
-  ObjectiveSpec s;
-  s.type = "shape";
-  s.frame = 1;
-  s.weight = 1.5;
-  s.margin = 0.4;
-  s.polygon = {{-1, 0}, {1, 0}, {1, 1}, {3, 1}, {3, 2}, {1, 2}, {1, 3}, {-1, 3}};  // an L-ish concave region
+  ShapeKeyframe shape;
+  shape.margin = 0.4;
+  shape.polygon = {{-1, 0}, {1, 0}, {1, 1}, {3, 1}, {3, 2}, {1, 2}, {1, 3}, {-1, 3}};  // an L-ish concave region
+  ObjectiveSpec s{.kind = shape, .frame = 1, .weight = 1.5};
   // Agents far outside, just outside, just inside (within the margin) and deep inside.
   const std::vector<Vec2> at = {{-2.5, 1.2}, {1.1, 0.5}, {0.8, 2.6}, {2.5, 1.2}, {0, 1.5}, {4, 3}, {1.3, 2.2}};
   const int p = int(at.size());
@@ -209,11 +207,11 @@ TEST(ShapeTerm, MarginGradientMatchesFiniteDifferencesInsideAndOutside) {
     EXPECT_LE(std::abs(fd - gx[k]) / std::max(std::abs(fd), floor), 1e-6) << "component " << k;
   }
   // Margin 0 is exactly the plain outside-only term.
-  s.margin = 0;
+  std::get<ShapeKeyframe>(s.kind).margin = 0;
   auto plain = make_objective_term(s, p);
   VecX g0 = VecX::Zero(3 * p);
   double expect = 0;
-  for (int i = 0; i < p; ++i) expect += 0.5 * 1.5 * (at[i] - closest_point_in_polygon(s.polygon, at[i])).squaredNorm();
+  for (int i = 0; i < p; ++i) expect += 0.5 * 1.5 * (at[i] - closest_point_in_polygon(shape.polygon, at[i])).squaredNorm();
   EXPECT_NEAR(plain->eval(x, v, g0, gv), expect, 1e-12);
 }
 

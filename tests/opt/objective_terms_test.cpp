@@ -12,7 +12,7 @@ void check_term(const ObjectiveSpec& spec, int p, unsigned seed) {
   VecX x = 2.0 * VecX::Random(3 * p), v = VecX::Random(3 * p);
   VecX gx = VecX::Zero(3 * p), gv = VecX::Zero(3 * p), dx(3 * p), dv(3 * p);
   term->eval(x, v, gx, gv);
-  ASSERT_GT(gx.norm() + gv.norm(), 1e-6) << spec.type;
+  ASSERT_GT(gx.norm() + gv.norm(), 1e-6) << type_name(spec);
   VecX sx(3 * p), sv(3 * p);
   for (int k = 0; k < 3 * p; ++k) {
     for (int which = 0; which < 2; ++which) {
@@ -26,17 +26,17 @@ void check_term(const ObjectiveSpec& spec, int p, unsigned seed) {
       (which ? dv : dx)[k] = (fp - fm) / (2 * e);
     }
   }
-  EXPECT_LT((dx - gx).norm(), 1e-6 * std::max(1.0, gx.norm())) << spec.type;
-  EXPECT_LT((dv - gv).norm(), 1e-6 * std::max(1.0, gv.norm())) << spec.type;
+  EXPECT_LT((dx - gx).norm(), 1e-6 * std::max(1.0, gx.norm())) << type_name(spec);
+  EXPECT_LT((dv - gv).norm(), 1e-6 * std::max(1.0, gv.norm())) << type_name(spec);
 }
 
 TEST(ObjectiveTerms, GradientsMatchFiniteDifferences) {
-  ObjectiveSpec pos{.type = "position", .frame = 1, .weight = 2.0, .particles = {1, 3}, .targets = {Vec3(1, 2, 3), Vec3(0, 0, 1)}};
-  ObjectiveSpec vel{.type = "velocity", .frame = 1, .weight = 0.5, .targets = {Vec3(0.2, 0, 0)}};
-  ObjectiveSpec com{.type = "center_of_mass", .frame = 1, .weight = 3.0, .targets = {Vec3(0.5, 0.5, 0.5)}};
-  ObjectiveSpec shape{.type = "shape", .frame = 1, .weight = 1.5,
-                      .polygon = {Vec2(-0.5, -0.5), Vec2(0.5, -0.5), Vec2(0.5, 0.5), Vec2(-0.5, 0.5)}};
-  ObjectiveSpec arch{.type = "arch", .frame = 1, .weight = 1.0, .axis_point = Vec3(0, -1, 0), .axis = Vec3(0, 0, 1), .radius = 1.5};
+  ObjectiveSpec pos{.kind = PositionKeyframe{{Vec3(1, 2, 3), Vec3(0, 0, 1)}}, .frame = 1, .weight = 2.0, .particles = {1, 3}};
+  ObjectiveSpec vel{.kind = VelocityKeyframe{{Vec3(0.2, 0, 0)}}, .frame = 1, .weight = 0.5};
+  ObjectiveSpec com{.kind = CenterOfMassKeyframe{Vec3(0.5, 0.5, 0.5)}, .frame = 1, .weight = 3.0};
+  ObjectiveSpec shape{.kind = ShapeKeyframe{{Vec2(-0.5, -0.5), Vec2(0.5, -0.5), Vec2(0.5, 0.5), Vec2(-0.5, 0.5)}},
+                      .frame = 1, .weight = 1.5};
+  ObjectiveSpec arch{.kind = ArchKeyframe{Vec3(0, -1, 0), Vec3(0, 0, 1), 1.5}, .frame = 1, .weight = 1.0};
   for (unsigned seed : {1u, 2u, 3u})
     for (const auto& s : {pos, vel, com, shape, arch}) check_term(s, 6, seed);
 }

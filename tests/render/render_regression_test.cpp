@@ -45,19 +45,15 @@ Image render_case(const Case& c, const fs::path& tmp, const std::function<void(R
   RunData run = load_run(dir);
   if (run.scene.cloth) {
     // Colliders are added here so the test does not depend on how the scene file spells them.
-    ColliderSpec sphere;
-    sphere.type = "sphere";
+    SphereShape sphere;
     sphere.center = Vec3(0.2, 0.45, 0.1);
     sphere.radius = 0.3;
-    ColliderSpec ring;
-    ring.type = "torus";
+    TorusShape ring;
     ring.center = Vec3(-0.4, 1.5, -0.3);
     ring.axis = Vec3(0, 0.3, 1).normalized();
     ring.radius = 0.25;
     ring.tube_radius = 0.03;
-    ColliderSpec ground;
-    ground.type = "ground";
-    run.scene.cloth->colliders = {sphere, ring, ground};
+    run.scene.cloth->colliders = {{sphere}, {ring}, {GroundShape{}}};
   }
   if (tweak) tweak(run);
   FrameRenderer renderer(run, c.backend, {kWidth, kHeight, c.spp});

@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "sim/cloth/collider.h"
 
@@ -55,6 +56,42 @@ void check_contact(const Collider& c, const Vec3& x, const char* what) {
                                                                    << fdk.transpose();
 }
 
+// The whole-cloth form the exact adjoint calls: add_definite_stiffness_derivative at particles placed at
+// `points` (some in contact, some not) against central differences of sum_i w_i . Kd(x_i) c_i.
+void check_whole_cloth_derivative(const Collider& col, const std::vector<Vec3>& points, const char* what) {
+  const int p = int(points.size());
+  VecX x(3 * p), w(3 * p), c(3 * p);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (int i = 0; i < p; ++i) {
+    seg(x, i) = points[size_t(i)];
+    seg(w, i) = Vec3(U(rng), U(rng), U(rng));
+    seg(c, i) = Vec3(U(rng), U(rng), U(rng));
+  }
+  auto wKc = [&](const VecX& at) {
+    double sum = 0;
+    for (int i = 0; i < p; ++i) {
+      ContactForce out;
+      if (col.contact(0, seg(at, i), Vec3::Zero(), true, out)) sum += seg(w, i).dot(out.dfdx * seg(c, i));
+    }
+    return sum;
+  };
+  const double scale = 0.3;
+  VecX got = VecX::Zero(3 * p);
+  col.add_definite_stiffness_derivative(0, x, w, c, scale, got);
+  ASSERT_GT(got.norm(), 0) << what;
+  const double eps = 1e-7;
+  VecX fd(3 * p);
+  for (int k = 0; k < 3 * p; ++k) {
+    VecX xp = x, xm = x;
+    xp[k] += eps;
+    xm[k] -= eps;
+    fd[k] = scale * (wKc(xp) - wKc(xm)) / (2 * eps);
+  }
+  EXPECT_LT((got - fd).norm(), 1e-5 * std::max(fd.norm(), 1.0)) << what << "\n" << got.transpose() << "\n"
+                                                                 << fd.transpose();
+}
+
 TEST(ContactProfile, StiffnessRisesSmoothlyAndMatchesItsDerivatives) {
   const ContactProfile p{1e4, 0.01};
   double g, dg, ddg, gp, dgp, ddgp, gm, dgm, ddgm;
@@ -84,46 +121,49 @@ TEST(ContactProfile, StiffnessRisesSmoothlyAndMatchesItsDerivatives) {
   EXPECT_DOUBLE_EQ(dg, 1e4);
 }
 
-ColliderSpec spec(const std::string& type) {
-  ColliderSpec s;
-  s.type = type;
-  s.center = Vec3(0.1, 0.2, -0.3);
-  s.axis = Vec3(0.2, 1.0, 0.1).normalized();
-  s.radius = 0.4;
-  s.tube_radius = 0.05;
-  s.thickness = 0.02;
-  s.stiffness = 1e4;
-  return s;
-}
+const Vec3 kCenter(0.1, 0.2, -0.3);
+const Vec3 kAxis = Vec3(0.2, 1.0, 0.1).normalized();
+constexpr double kThickness = 0.02, kStiffness = 1e4, kRamp = 0.5 * kThickness;
+
+const GroundShape kGround{kCenter, kAxis};
+const SphereShape kSphere{kCenter, 0.4};
+const TorusShape kTorus{kCenter, kAxis, 0.4, 0.05};
+const CapsuleShape kCapsule{kCenter, kCenter + Vec3(0.5, 0.3, -0.2), 0.1};
 
 TEST(ClothCollider, GroundJacobianAndSeparation) {
-  const ColliderSpec s = spec("ground");
-  GroundCollider g(s, 0.5 * s.thickness);
-  check_contact(g, s.center + 0.013 * s.axis + Vec3(0.3, 0, 0.1).cross(s.axis), "ground");
-  check_contact(g, s.center - 0.05 * s.axis, "ground (penetrating)");
+  const GroundShape& s = kGround;
+  GroundCollider g(s, kThickness, kStiffness, kRamp);
+  check_contact(g, s.point + 0.013 * s.normal + Vec3(0.3, 0, 0.1).cross(s.normal), "ground");
+  check_contact(g, s.point - 0.05 * s.normal, "ground (penetrating)");
+  check_whole_cloth_derivative(g, {s.point + 0.015 * s.normal, s.point + 0.05 * s.normal, s.point - 0.01 * s.normal},
+                               "ground");
   ContactForce out;
-  EXPECT_FALSE(g.contact(0, s.center + 0.03 * s.axis, Vec3::Zero(), false, out));
+  EXPECT_FALSE(g.contact(0, s.point + 0.03 * s.normal, Vec3::Zero(), false, out));
 }
 
 TEST(ClothCollider, SphereJacobianMatchesFiniteDifferences) {
-  const ColliderSpec s = spec("sphere");
-  SphereCollider c(s, 0.5 * s.thickness);
+  const SphereShape& s = kSphere;
+  SphereCollider c(s, kThickness, kStiffness, kRamp);
   std::mt19937 rng(2);
   std::normal_distribution<double> N;
   std::uniform_real_distribution<double> U(-0.9, 0.9);
   for (int t = 0; t < 10; ++t) {
     const Vec3 dir = Vec3(N(rng), N(rng), N(rng)).normalized();
-    check_contact(c, s.center + (s.radius + U(rng) * s.thickness) * dir, "sphere");
+    check_contact(c, s.center + (s.radius + U(rng) * kThickness) * dir, "sphere");
   }
+  check_whole_cloth_derivative(c, {s.center + Vec3(0, s.radius + 0.3 * kThickness, 0),
+                                   s.center + Vec3(0.2, 0.1, s.radius).normalized() * (s.radius - 0.5 * kThickness),
+                                   s.center + Vec3(2 * s.radius, 0, 0)},
+                               "sphere");
   ContactForce out;
-  EXPECT_FALSE(c.contact(0, s.center + Vec3(0, s.radius + 1.01 * s.thickness, 0), Vec3::Zero(), false, out));
+  EXPECT_FALSE(c.contact(0, s.center + Vec3(0, s.radius + 1.01 * kThickness, 0), Vec3::Zero(), false, out));
   EXPECT_TRUE(c.contact(0, s.center, Vec3::Zero(), false, out));  // dead centre: finite push
   EXPECT_TRUE(out.f.allFinite() && out.dfdx.allFinite());
 }
 
 TEST(ClothCollider, TorusJacobianMatchesFiniteDifferences) {
-  const ColliderSpec s = spec("torus");
-  TorusCollider c(s, 0.5 * s.thickness);
+  const TorusShape& s = kTorus;
+  TorusCollider c(s, kThickness, kStiffness, kRamp);
   const Vec3 a = s.axis;
   const Vec3 e1 = a.unitOrthogonal(), e2 = a.cross(e1);
   std::mt19937 rng(4);
@@ -131,9 +171,12 @@ TEST(ClothCollider, TorusJacobianMatchesFiniteDifferences) {
   for (int t = 0; t < 10; ++t) {
     const double th = angle(rng), ps = angle(rng);
     const Vec3 radial = std::cos(th) * e1 + std::sin(th) * e2;
-    const double d = s.tube_radius + U(rng) * s.thickness;
+    const double d = s.tube_radius + U(rng) * kThickness;
     check_contact(c, s.center + s.radius * radial + d * (std::cos(ps) * radial + std::sin(ps) * a), "torus");
   }
+  check_whole_cloth_derivative(c, {s.center + s.radius * e1 + (s.tube_radius + 0.4 * kThickness) * a,
+                                   s.center + s.radius * e2 - (s.tube_radius - 0.3 * kThickness) * e2, s.center},
+                               "torus");
   ContactForce out;
   EXPECT_FALSE(c.contact(0, s.center, Vec3::Zero(), false, out));  // the hole of the ring is free
   EXPECT_FALSE(c.contact(0, s.center + 0.3 * a, Vec3::Zero(), false, out));
@@ -142,11 +185,44 @@ TEST(ClothCollider, TorusJacobianMatchesFiniteDifferences) {
   EXPECT_TRUE(out.f.allFinite() && out.dfdx.allFinite());
 }
 
+TEST(ClothCollider, CapsuleJacobianMatchesFiniteDifferences) {
+  const CapsuleShape& s = kCapsule;
+  CapsuleCollider c(s, kThickness, kStiffness, kRamp);
+  const Vec3 e = (s.b - s.a).normalized(), e1 = e.unitOrthogonal(), e2 = e.cross(e1);
+  const double length = (s.b - s.a).norm();
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> angle(0, 2 * M_PI), along(0.05, 0.95), U(-0.9, 0.9), cap(0.1, 1.4);
+  for (int t = 0; t < 10; ++t) {  // beside the cylinder, away from the caps' seams
+    const double th = angle(rng);
+    const Vec3 radial = std::cos(th) * e1 + std::sin(th) * e2;
+    check_contact(c, s.a + along(rng) * length * e + (s.radius + U(rng) * kThickness) * radial, "capsule side");
+  }
+  for (int t = 0; t < 10; ++t) {  // on the caps, beyond either end
+    const double th = angle(rng), polar = cap(rng);
+    const Vec3 radial = std::cos(th) * e1 + std::sin(th) * e2;
+    const Vec3 dir = std::cos(polar) * e + std::sin(polar) * radial;
+    const double d = s.radius + U(rng) * kThickness;
+    check_contact(c, t % 2 ? Vec3(s.b + d * dir) : Vec3(s.a - d * dir), "capsule cap");
+  }
+  check_whole_cloth_derivative(c, {s.a + 0.5 * length * e + (s.radius + 0.4 * kThickness) * e1,
+                                   s.b + (s.radius + 0.2 * kThickness) * (e + e2).normalized(),
+                                   s.a - (s.radius - 0.5 * kThickness) * e, s.a + 0.3 * length * e + 3 * s.radius * e2},
+                               "capsule");
+  ContactForce out;
+  EXPECT_FALSE(c.contact(0, s.a + 0.5 * length * e + (s.radius + 1.01 * kThickness) * e1, Vec3::Zero(), false, out));
+  EXPECT_FALSE(c.contact(0, s.b + (s.radius + 1.01 * kThickness) * e, Vec3::Zero(), false, out));
+  EXPECT_TRUE(c.contact(0, s.a + 0.5 * length * e, Vec3::Zero(), false, out));  // on the axis: a finite push
+  EXPECT_TRUE(out.f.allFinite() && out.dfdx.allFinite());
+  EXPECT_NEAR(out.f.dot(e), 0.0, 1e-12);
+}
+
 TEST(ClothCollider, FactoryBuildsOnePerSpecAndNoneForNone) {
   EXPECT_TRUE(make_colliders({}, 0.5).empty());
-  auto cs = make_colliders({spec("ground"), spec("sphere"), spec("torus")}, 0.5);
-  ASSERT_EQ(cs.size(), 3u);
+  const auto spec = [](ColliderShape shape) { return ColliderSpec{shape, kThickness, kStiffness}; };
+  auto cs = make_colliders({spec(kGround), spec(kSphere), spec(kTorus), spec(kCapsule)}, 0.5);
+  ASSERT_EQ(cs.size(), 4u);
   EXPECT_NE(dynamic_cast<TorusCollider*>(cs[2].get()), nullptr);
+  EXPECT_NE(dynamic_cast<CapsuleCollider*>(cs[3].get()), nullptr);
 }
 
 }  // namespace

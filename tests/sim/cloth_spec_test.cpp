@@ -51,7 +51,8 @@ TEST(ClothSpec, CollidersAndErrorsNameTheirPlace) {
       R"({"colliders": [{"type": "ground"}, {"type": "torus", "center": [0, 1, 0], "radius": 0.2,
           "tube_radius": 0.02, "axis": [0, 0, 2]}]})");
   ASSERT_EQ(s.cloth->colliders.size(), 2u);
-  EXPECT_EQ(s.cloth->colliders[1].axis, Vec3(0, 0, 1));
+  EXPECT_EQ(std::get<TorusShape>(s.cloth->colliders[1].shape).axis, Vec3(0, 0, 1));
+  EXPECT_STREQ(type_name(s.cloth->colliders[0]), "ground");
   EXPECT_EQ(make_system(s)->describe(), "cloth: 16x16 particles, 1378 springs, 0 pinned, 2 colliders, PCG (incomplete_cholesky), exact adjoint");
   EXPECT_EQ(scene_with(R"({"cg_preconditioner": "block_jacobi"})").cloth->cg_preconditioner, "block_jacobi");
   EXPECT_NE(error_of(R"({"cg_preconditioner": "ilu"})").find("/cloth/cg_preconditioner: expected one of"),

@@ -46,14 +46,17 @@ ClothSpec spec_of(const ThrowCase& c, int max_halvings = 8) {
     spec.origin = Vec3(-0.5, 1.0, -0.5);
     spec.v_axis = Vec3(0, 0.6, 0.8);  // tilted, 1.0 .. 1.6 m high
   }
-  ColliderSpec body;
-  body.type = c.body;
-  if (c.body == "ground") body.center = Vec3(0, c.pinned ? 0.45 : 0.0, 0);  // the swing's lowest row grazes it
-  if (c.body == "sphere") {
-    body.center = c.pinned ? Vec3(0, 0.3, 0.45) : Vec3(0.3, 0.35, 0.6);  // in the swing's path / under the fall
-    body.radius = 0.35;
+  if (c.body == "ground") {
+    GroundShape ground;
+    ground.point = Vec3(0, c.pinned ? 0.45 : 0.0, 0);  // the swing's lowest row grazes it
+    spec.colliders.push_back({ground});
   }
-  if (c.body != "none") spec.colliders.push_back(body);
+  if (c.body == "sphere") {
+    SphereShape sphere;
+    sphere.center = c.pinned ? Vec3(0, 0.3, 0.45) : Vec3(0.3, 0.35, 0.6);  // in the swing's path / under the fall
+    sphere.radius = 0.35;
+    spec.colliders.push_back({sphere});
+  }
   return spec;
 }
 

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/check.h"
+
 namespace kf {
 namespace {
 
@@ -49,11 +51,7 @@ void throw_on_embree_error(RTCDevice device, const char* what) {
 }  // namespace
 
 BodyQuery::BodyQuery(const TriangleIndices& triangles, int vertex_count)
-    : surface_(triangles, vertex_count), device_(rtcNewDevice(nullptr)) {
-  if (!device_) throw std::runtime_error("Embree: cannot create a device");
-  scene_ = EmbreeScene(rtcNewScene(device_.get()));
-  rtcSetSceneFlags(scene_.get(), RTC_SCENE_FLAG_DYNAMIC);
-  rtcSetSceneBuildQuality(scene_.get(), RTC_BUILD_QUALITY_LOW);
+    : surface_(triangles, vertex_count), device_(new_embree_device()), scene_(new_dynamic_scene(device_)) {
   EmbreeGeometry geometry(rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_TRIANGLE));
   rtcSetGeometryBuildQuality(geometry.get(), RTC_BUILD_QUALITY_REFIT);
   vertex_buffer_ = static_cast<float*>(rtcSetNewGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_VERTEX, 0,
@@ -79,7 +77,7 @@ void BodyQuery::update(const VecX& x) {
 }
 
 BodyHit BodyQuery::closest(const Vec3& p, double radius) const {
-  if (!built_) throw std::logic_error("BodyQuery::closest before update()");
+  CHECK(built_);  // update() first
   PointQueryState state{&surface_, p};
   RTCPointQuery query;
   query.x = static_cast<float>(p.x());

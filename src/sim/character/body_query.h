@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "sim/character/body_surface.h"
-#include "sim/character/embree_handles.h"
+#include "core/embree_handles.h"
 
 namespace kf {
 

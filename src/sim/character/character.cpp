@@ -46,28 +46,9 @@ Affine channel_local(const CharacterChannel& ch, double t) {
 
 }  // namespace
 
-Character::Character(const std::filesystem::path& file, const CharacterOptions& options) : options_(options) {
-  const std::string name = file.string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec))
-    throw InputError(name + ": character mesh not found (expected a file assimp can read, e.g. .X)");
-
-  Assimp::Importer importer;
-  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_LimitBoneWeights |
-                         aiProcess_PopulateArmatureData;
-  importer.SetPropertyInteger(AI_CONFIG_PP_LBW_MAX_WEIGHTS, kMaxInfluences);
-  const aiScene* scene = importer.ReadFile(name, flags);
-  if (!scene) throw InputError(name + ": cannot read character mesh: " + importer.GetErrorString());
-  if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !scene->mRootNode || scene->mNumMeshes == 0)
-    throw InputError(name + ": character file has no complete mesh");
-  if (scene->mNumAnimations == 0) throw InputError(name + ": character file has no animation");
-  if (options.animation < 0 || options.animation >= static_cast<int>(scene->mNumAnimations))
-    throw InputError(name + ": animation " + std::to_string(options.animation) + " requested, file has " +
-                     std::to_string(scene->mNumAnimations));
-
-  // Node hierarchy, parents first.
-  std::unordered_map<std::string, int> by_name;
-  std::vector<const aiNode*> stack = {scene->mRootNode};
+// Node hierarchy, parents first; by_name: node name -> index.
+void Character::read_nodes(const aiScene& scene, std::unordered_map<std::string, int>& by_name) {
+  std::vector<const aiNode*> stack = {scene.mRootNode};
   std::vector<int> stack_parent = {-1};
   while (!stack.empty()) {
     const aiNode* n = stack.back();
@@ -82,9 +63,11 @@ Character::Character(const std::filesystem::path& file, const CharacterOptions& 
       stack_parent.push_back(index);
     }
   }
+}
 
-  // Animation channels, times converted from ticks to seconds.
-  const aiAnimation* anim = scene->mAnimations[options.animation];
+// Animation channels, times converted from ticks to seconds.
+void Character::read_channels(const aiScene& scene, const aiAnimation* anim,
+                              const std::unordered_map<std::string, int>& by_name) {
   const double tps = anim->mTicksPerSecond > 0.0 ? anim->mTicksPerSecond : 25.0;  // assimp's convention
   duration_ = anim->mDuration / tps;
   for (unsigned c = 0; c < anim->mNumChannels; ++c) {
@@ -95,7 +78,7 @@ Character::Character(const std::filesystem::path& file, const CharacterOptions& 
     ch.node = it->second;
     aiVector3D rest_s, rest_p;
     aiQuaternion rest_q;
-    scene->mRootNode->FindNode(a->mNodeName)->mTransformation.Decompose(rest_s, rest_q, rest_p);
+    scene.mRootNode->FindNode(a->mNodeName)->mTransformation.Decompose(rest_s, rest_q, rest_p);
     for (unsigned k = 0; k < a->mNumPositionKeys; ++k) {
       const auto& key = a->mPositionKeys[k];
       ch.position_times.push_back(key.mTime / tps);
@@ -119,13 +102,16 @@ Character::Character(const std::filesystem::path& file, const CharacterOptions& 
     nodes_[ch.node].channel = static_cast<int>(channels_.size());
     channels_.push_back(std::move(ch));
   }
+}
 
-  // Joined meshes, bones and per-vertex influences.
+// Joined meshes, bones and per-vertex influences. name: the file, for messages.
+void Character::read_meshes(const aiScene& scene, const std::unordered_map<std::string, int>& by_name,
+                            const std::string& name) {
   int total_vertices = 0, total_triangles = 0;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    total_vertices += static_cast<int>(scene->mMeshes[m]->mNumVertices);
-    for (unsigned f = 0; f < scene->mMeshes[m]->mNumFaces; ++f)
-      total_triangles += scene->mMeshes[m]->mFaces[f].mNumIndices == 3 ? 1 : 0;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    total_vertices += static_cast<int>(scene.mMeshes[m]->mNumVertices);
+    for (unsigned f = 0; f < scene.mMeshes[m]->mNumFaces; ++f)
+      total_triangles += scene.mMeshes[m]->mFaces[f].mNumIndices == 3 ? 1 : 0;
   }
   raw_vertices_.resize(3 * total_vertices);
   triangles_.resize(total_triangles, 3);
@@ -133,8 +119,8 @@ Character::Character(const std::filesystem::path& file, const CharacterOptions& 
   influence_weights_.assign(kMaxInfluences * total_vertices, 0.0);
   std::vector<int> slots_used(total_vertices, 0);
   int v0 = 0, t = 0;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh* mesh = scene->mMeshes[m];
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* mesh = scene.mMeshes[m];
     mesh_names_.push_back(mesh->mName.C_Str());
     mesh_vertex_begin_.push_back(v0);
     for (unsigned v = 0; v < mesh->mNumVertices; ++v)
@@ -170,7 +156,7 @@ Character::Character(const std::filesystem::path& file, const CharacterOptions& 
     }
     // Vertices no bone moves follow their mesh's node rigidly (a bone with an identity offset).
     const aiNode* mesh_node = nullptr;
-    std::vector<const aiNode*> search = {scene->mRootNode};
+    std::vector<const aiNode*> search = {scene.mRootNode};
     while (!search.empty() && !mesh_node) {
       const aiNode* n = search.back();
       search.pop_back();
@@ -192,6 +178,31 @@ Character::Character(const std::filesystem::path& file, const CharacterOptions& 
     v0 += static_cast<int>(mesh->mNumVertices);
   }
   mesh_vertex_begin_.push_back(v0);
+}
+
+Character::Character(const std::filesystem::path& file, const CharacterOptions& options) : options_(options) {
+  const std::string name = file.string();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec))
+    throw InputError(name + ": character mesh not found (expected a file assimp can read, e.g. .X)");
+
+  Assimp::Importer importer;
+  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_LimitBoneWeights |
+                         aiProcess_PopulateArmatureData;
+  importer.SetPropertyInteger(AI_CONFIG_PP_LBW_MAX_WEIGHTS, kMaxInfluences);
+  const aiScene* scene = importer.ReadFile(name, flags);
+  if (!scene) throw InputError(name + ": cannot read character mesh: " + importer.GetErrorString());
+  if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !scene->mRootNode || scene->mNumMeshes == 0)
+    throw InputError(name + ": character file has no complete mesh");
+  if (scene->mNumAnimations == 0) throw InputError(name + ": character file has no animation");
+  if (options.animation < 0 || options.animation >= static_cast<int>(scene->mNumAnimations))
+    throw InputError(name + ": animation " + std::to_string(options.animation) + " requested, file has " +
+                     std::to_string(scene->mNumAnimations));
+
+  std::unordered_map<std::string, int> by_name;
+  read_nodes(*scene, by_name);
+  read_channels(*scene, scene->mAnimations[options.animation], by_name);
+  read_meshes(*scene, by_name, name);
   if (bones_.empty() || channels_.empty()) throw InputError(name + ": character file has no skinned bones");
   if (triangles_.rows() == 0) throw InputError(name + ": character file has no triangles");
 

@@ -9,9 +9,13 @@
 #include <Eigen/Geometry>
 #include <filesystem>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "core/types.h"
+
+struct aiScene;
+struct aiAnimation;
 
 namespace kf {
 
@@ -99,6 +103,10 @@ class Character {
 
  private:
   void evaluate_nodes(double t);  // fills world_ at time t
+  // Loading, in this order (the constructor).
+  void read_nodes(const aiScene& scene, std::unordered_map<std::string, int>& by_name);
+  void read_channels(const aiScene& scene, const aiAnimation* anim, const std::unordered_map<std::string, int>& by_name);
+  void read_meshes(const aiScene& scene, const std::unordered_map<std::string, int>& by_name, const std::string& name);
 
   CharacterOptions options_;
   VecX raw_vertices_;   // as stored in the file (mesh frame), 3n

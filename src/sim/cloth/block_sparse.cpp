@@ -5,6 +5,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/check.h"
+
 namespace kf {
 
 void BlockSparse3::set_pattern(const std::vector<std::vector<int>>& cols) {
@@ -20,7 +22,7 @@ void BlockSparse3::set_pattern(const std::vector<std::vector<int>>& cols) {
       if (j == i) diag_[i] = int(col_.size());
       col_.push_back(j);
     }
-    if (diag_[i] < 0) throw std::invalid_argument("block pattern row without its diagonal");
+    CHECK_GE(diag_[i], 0);  // every row holds its diagonal block
     row_start_.push_back(int(col_.size()));
   }
   val_.assign(col_.size(), Mat3::Zero());

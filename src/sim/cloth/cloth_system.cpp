@@ -106,11 +106,10 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   aw_.setZero(3 * p_);
   w_.setZero(3 * p_);
   c_.setZero(3 * p_);
-  direct_solve_ = spec.solver == "direct";
+  direct_solve_ = spec.direct_solver();
   split_x_.resize(spec.max_halvings);
   split_v_.resize(spec.max_halvings);
-  pcg_.resize(p_, spec.cg_preconditioner == "block_jacobi" ? Preconditioner::kBlockJacobi
-                                                           : Preconditioner::kIncompleteCholesky);
+  pcg_.resize(p_, spec.block_jacobi() ? Preconditioner::kBlockJacobi : Preconditioner::kIncompleteCholesky);
 }
 
 void ClothSystem::initial_state(VecX& x, VecX& v) const {

@@ -1,9 +1,13 @@
 #include "sim/cloth/collider.h"
 
+#include <algorithm>
 #include <cmath>
-#include <stdexcept>
+
+#include <Eigen/Geometry>  // unitOrthogonal
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+
+#include "core/overloaded.h"
 
 namespace kf {
 
@@ -52,8 +56,8 @@ Vec3 DistanceCollider::definite_stiffness_derivative(int, const Vec3& x, const V
   return ddg * wn * cn * n - dg * (cn * (dn.transpose() * w) + wn * (dn.transpose() * c));
 }
 
-GroundCollider::GroundCollider(const ColliderSpec& s, double ramp)
-    : DistanceCollider(s.thickness, s.stiffness, ramp), point_(s.center), normal_(s.axis.normalized()) {}
+GroundCollider::GroundCollider(const GroundShape& s, double thickness, double stiffness, double ramp)
+    : DistanceCollider(thickness, stiffness, ramp), point_(s.point), normal_(s.normal.normalized()) {}
 
 void GroundCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const {
   phi = normal_.dot(x - point_);
@@ -61,8 +65,8 @@ void GroundCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dn
   dnormal_dx.setZero();
 }
 
-SphereCollider::SphereCollider(const ColliderSpec& s, double ramp)
-    : DistanceCollider(s.thickness, s.stiffness, ramp), center_(s.center), radius_(s.radius) {}
+SphereCollider::SphereCollider(const SphereShape& s, double thickness, double stiffness, double ramp)
+    : DistanceCollider(thickness, stiffness, ramp), center_(s.center), radius_(s.radius) {}
 
 void SphereCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const {
   const Vec3 d = x - center_;
@@ -78,8 +82,8 @@ void SphereCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dn
   dnormal_dx = (Mat3::Identity() - normal * normal.transpose()) / r;
 }
 
-TorusCollider::TorusCollider(const ColliderSpec& s, double ramp)
-    : DistanceCollider(s.thickness, s.stiffness, ramp),
+TorusCollider::TorusCollider(const TorusShape& s, double thickness, double stiffness, double ramp)
+    : DistanceCollider(thickness, stiffness, ramp),
       center_(s.center),
       axis_(s.axis.normalized()),
       major_(s.radius),
@@ -115,14 +119,53 @@ void TorusCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dno
   dnormal_dx = (Mat3::Identity() - normal * normal.transpose()) / d * dw;
 }
 
+CapsuleCollider::CapsuleCollider(const CapsuleShape& s, double thickness, double stiffness, double ramp)
+    : DistanceCollider(thickness, stiffness, ramp),
+      a_(s.a),
+      axis_((s.b - s.a).normalized()),
+      length_((s.b - s.a).norm()),
+      radius_(s.radius) {}
+
+void CapsuleCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const {
+  // The closest point of the segment: q = a + t axis, t clamped to [0, length].
+  const double s = axis_.dot(x - a_);
+  const bool side = s > 0 && s < length_;  // beside the cylinder, not at a cap
+  const Vec3 q = a_ + std::clamp(s, 0.0, length_) * axis_;
+  const Vec3 w = x - q;
+  const double d = w.norm();
+  if (d < 1e-12 * radius_) {  // on the axis every direction across it is as near; pick one so the push is finite
+    phi = -radius_;
+    normal = axis_.unitOrthogonal();
+    dnormal_dx.setZero();
+    return;
+  }
+  phi = d - radius_;
+  normal = w / d;
+  // dn/dx = (I - n n^T)/d dw/dx, with dw/dx = I - axis axis^T beside the cylinder and I at a cap.
+  const Mat3 across = (Mat3::Identity() - normal * normal.transpose()) / d;
+  dnormal_dx = side ? Mat3(across * (Mat3::Identity() - axis_ * axis_.transpose())) : across;
+}
+
 std::vector<std::unique_ptr<Collider>> make_colliders(const std::vector<ColliderSpec>& specs, double ramp_fraction) {
   std::vector<std::unique_ptr<Collider>> out;
   for (const ColliderSpec& s : specs) {
     const double ramp = ramp_fraction * s.thickness;
-    if (s.type == "ground") out.push_back(std::make_unique<GroundCollider>(s, ramp));
-    else if (s.type == "sphere") out.push_back(std::make_unique<SphereCollider>(s, ramp));
-    else if (s.type == "torus") out.push_back(std::make_unique<TorusCollider>(s, ramp));
-    else throw std::invalid_argument("unknown collider type \"" + s.type + "\"");
+    out.push_back(std::visit(
+        Overloaded{
+            [&](const GroundShape& g) -> std::unique_ptr<Collider> {
+              return std::make_unique<GroundCollider>(g, s.thickness, s.stiffness, ramp);
+            },
+            [&](const SphereShape& g) -> std::unique_ptr<Collider> {
+              return std::make_unique<SphereCollider>(g, s.thickness, s.stiffness, ramp);
+            },
+            [&](const TorusShape& g) -> std::unique_ptr<Collider> {
+              return std::make_unique<TorusCollider>(g, s.thickness, s.stiffness, ramp);
+            },
+            [&](const CapsuleShape& g) -> std::unique_ptr<Collider> {
+              return std::make_unique<CapsuleCollider>(g, s.thickness, s.stiffness, ramp);
+            },
+        },
+        s.shape));
   }
   return out;
 }

@@ -47,7 +47,7 @@ class Collider {
   virtual void add_cross_transpose(int /*n*/, const VecX& /*w*/, double /*scale*/, VecX& /*out*/) const {}
 };
 
-// A signed-distance collider: the three analytic shapes only supply phi, n and dn/dx.
+// A signed-distance collider: the analytic shapes only supply phi, n and dn/dx.
 class DistanceCollider : public Collider {
  public:
   // ramp: the width of the contact profile's stiffness ramp, metres (0: linear penalty).
@@ -65,7 +65,7 @@ class DistanceCollider : public Collider {
 
 class GroundCollider final : public DistanceCollider {
  public:
-  GroundCollider(const ColliderSpec& s, double ramp);
+  GroundCollider(const GroundShape& s, double thickness, double stiffness, double ramp);
   void distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const override;
 
  private:
@@ -74,7 +74,7 @@ class GroundCollider final : public DistanceCollider {
 
 class SphereCollider final : public DistanceCollider {
  public:
-  SphereCollider(const ColliderSpec& s, double ramp);
+  SphereCollider(const SphereShape& s, double thickness, double stiffness, double ramp);
   void distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const override;
 
  private:
@@ -85,7 +85,7 @@ class SphereCollider final : public DistanceCollider {
 // The ring of the ring toss: a torus with major radius R around `axis` and tube radius r.
 class TorusCollider final : public DistanceCollider {
  public:
-  TorusCollider(const ColliderSpec& s, double ramp);
+  TorusCollider(const TorusShape& s, double thickness, double stiffness, double ramp);
   void distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const override;
 
  private:
@@ -93,7 +93,18 @@ class TorusCollider final : public DistanceCollider {
   double major_, tube_;
 };
 
-// One collider per spec entry, in order (empty for a scene without colliders). ramp_fraction: each
+// A capsule: distance to the segment a-b minus the radius (a cylinder with hemispherical caps).
+class CapsuleCollider final : public DistanceCollider {
+ public:
+  CapsuleCollider(const CapsuleShape& s, double thickness, double stiffness, double ramp);
+  void distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const override;
+
+ private:
+  Vec3 a_, axis_;  // one end and the unit direction to the other
+  double length_, radius_;
+};
+
+// One collider per spec entry, in order, each shape's class chosen by std::visit (empty for a scene without colliders). ramp_fraction: each
 // contact profile's ramp as a fraction of its collider's thickness.
 std::vector<std::unique_ptr<Collider>> make_colliders(const std::vector<ColliderSpec>& specs, double ramp_fraction);
 

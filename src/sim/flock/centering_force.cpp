@@ -12,36 +12,29 @@ void CenteringForce::prepare(const FlockState& s) {
     b_.resize(p);
   }
   parallel_agents(p, [&](int i) {
-    {
-      const Vec3 xi = seg(s.x, i);
-      Vec3 a = Vec3::Zero();
-      double b = 1.0;
-      for (int j : s.neighbors.neighbors(i)) {
-        const Vec3 e = seg(s.x, j) - xi;
-        const double w = smooth_kernel(e.squaredNorm(), p_.radius).w;
-        a += w * e;
-        b += w;
-      }
-      seg(offset_, i) = a / b;
-      b_[i] = b;
+    const Vec3 xi = seg(s.x, i);
+    Vec3 a = Vec3::Zero();
+    double b = 1.0;
+    for (int j : s.neighbors.neighbors(i)) {
+      const Vec3 d = xi - seg(s.x, j);
+      pair_.add_sums(d, d.squaredNorm(), a, b);
     }
+    seg(offset_, i) = a / b;
+    b_[i] = b;
   });
 }
 
 void CenteringForce::add_force(const FlockState& s, int i, Vec3& f) const { f += p_.strength * seg(offset_, i); }
 
-Vec3 CenteringForce::block_T_times(const FlockState& s, int i, int j, const Vec3& y3) const {
-  const Vec3 d = seg(s.x, i) - seg(s.x, j);
-  const KernelWeight k = smooth_kernel(d.squaredNorm(), p_.radius);
-  const Vec3 g = 2.0 * k.dw_dr2 * d;  // d w_ij / d x_i
-  return (p_.strength / b_[i]) * (k.w * y3 + (d + seg(offset_, i)).dot(y3) * g);
-}
-
 void CenteringForce::add_KT(const FlockState& s, const VecX& y, int j, Vec3& out) const {
-  // (K^T y)_j = (d f_j/d x_j)^T y_j + sum_i (d f_i/d x_j)^T y_i, and d f_j/d x_j = -sum_i d f_j/d x_i
-  // (translation invariance).
-  const Vec3 yj = seg(y, j);
-  for (int i : s.neighbors.neighbors(j)) out += block_T_times(s, i, j, seg(y, i)) - block_T_times(s, j, i, yj);
+  const Vec3 xj = seg(s.x, j), yj = seg(y, j), oj = seg(offset_, j);
+  const double cj = p_.strength / b_[j];
+  Vec3 kc = Vec3::Zero();
+  for (int i : s.neighbors.neighbors(j)) {
+    const Vec3 d = xj - seg(s.x, i);
+    pair_.add_KT(d, d.squaredNorm(), seg(y, i), yj, seg(offset_, i), oj, b_[i], cj, kc);
+  }
+  out += kc;
 }
 
 }  // namespace kf

@@ -6,17 +6,9 @@
 #include <tuple>
 #include <vector>
 
-namespace kf {
+#include "core/hash.h"
 
-namespace {
-uint64_t mix(uint64_t z) {
-  z += 0x9E3779B97F4A7C15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-double unit(uint64_t h) { return double(h >> 11) / 9007199254740992.0; }  // [0, 1)
-}  // namespace
+namespace kf {
 
 VecX spawn_positions(const FlockSpec& spec, unsigned seed) {
   const int p = spec.agents;
@@ -44,8 +36,8 @@ VecX spawn_positions(const FlockSpec& spec, unsigned seed) {
   VecX x = VecX::Zero(3 * p);
   for (int i = 0; i < p && i < int(points.size()); ++i) {
     const auto [r2, a, c] = points[i];
-    const uint64_t h = mix(mix(uint64_t(seed) ^ 0x5F1A7E5EEDULL) ^ uint64_t(i));
-    const double angle = 2 * M_PI * unit(h), rho = jitter * std::sqrt(unit(mix(h)));
+    const uint64_t h = mix64(mix64(uint64_t(seed) ^ 0x5F1A7E5EEDULL) ^ uint64_t(i));
+    const double angle = 2 * M_PI * unit_double(h), rho = jitter * std::sqrt(unit_double(mix64(h)));
     seg(x, i) = spec.spawn.center + Vec3(a * s + rho * std::cos(angle), 0.0, c * s + rho * std::sin(angle));
     x[3 * i + 1] = 0.0;
   }

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/check.h"
 #include "sim/flock/drag_force.h"
 #include "sim/flock/flock_spawn.h"
 #include "sim/flock/parallel_agents.h"
@@ -30,9 +31,8 @@ void FlockSystem::initial_state(VecX& x, VecX& v) const {
 }
 
 void FlockSystem::check_size(const VecX& x, const VecX& v) const {
-  if (x.size() != dof() || v.size() != dof())
-    throw std::invalid_argument("flock state has " + std::to_string(x.size()) + " entries, expected " +
-                                std::to_string(dof()));
+  CHECK_EQ(x.size(), dof());
+  CHECK_EQ(v.size(), dof());
 }
 
 void FlockSystem::search(FlockRecord& r, const VecX& x, bool with_centering) {
@@ -94,7 +94,12 @@ void FlockSystem::transpose_apply(const FlockRecord& r, int n, const VecX& x, co
   dt.setZero();
   if (neighbor_forces_.any())
     neighbor_forces_.transpose_apply(x, v, y, r.grid.neighbors(j), j, r.offset, r.b, kt, dt);
-  if (spec_.drag.strength > 0) dt -= spec_.drag.strength * seg(y, j);
+  // Local forces only through their interface, so a new one cannot drop out of the adjoint.
+  const FlockState s{n, x, v, r.grid};
+  for (const auto& force : local_forces_) {
+    force->add_KT(s, y, j, kt);
+    force->add_DT(s, y, j, dt);
+  }
 }
 
 void FlockSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX&, const StepRecord& record,

@@ -1,7 +1,8 @@
 #pragma once
 // Avoidance, velocity matching and centering evaluated together in one pass over each agent's
-// neighbour list, forward and transposed (the three terms' own files define them; this is their fused,
-// hot-loop form, checked against them in tests/sim/flock_forces_test.cpp).
+// neighbour list, forward and transposed: the loop sums each term's pair struct (AvoidancePair,
+// MatchingPair, CenteringPair, defined beside the terms) and scales by the strengths once per agent.
+// The terms' own classes sum the same structs one term at a time (tests/sim/flock_neighbor_forces_test.cpp).
 //
 // Forward, for agent i: the summed force and the centering quantities offset_i = m_i - x_i (m) and
 // b_i = 1 + sum_j w_ij that the transposed pass needs for every neighbour.
@@ -13,6 +14,9 @@
 
 #include "core/types.h"
 #include "scene/flock_spec.h"
+#include "sim/flock/avoidance_force.h"
+#include "sim/flock/centering_force.h"
+#include "sim/flock/matching_force.h"
 
 namespace kf {
 
@@ -36,8 +40,10 @@ class NeighborForces {
   void centering(const VecX& x, std::span<const int> nbrs, int i, Vec3& offset_i, double& b_i) const;
 
  private:
-  double ka_, ra2_, kmatch_, rm2_, kc_, rc2_;
-  double inv_ra2_, inv_rm2_, inv_rc2_, eps2_;
+  double ka_, kmatch_, kc_;  // strengths
+  AvoidancePair avoid_;
+  MatchingPair match_;
+  CenteringPair centre_;
   double radius_ = 0;
 };
 

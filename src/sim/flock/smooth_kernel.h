@@ -3,6 +3,8 @@
 // Value, slope and curvature vanish at r = R, so forces and their Jacobians are continuous at the
 // cut-off and the Jacobians have no kink there either (finite-difference checks stay at round-off).
 
+#include <cmath>
+
 namespace kf {
 
 struct KernelWeight {
@@ -16,6 +18,11 @@ inline KernelWeight smooth_kernel(double r2, double radius) {
   const double t = 1.0 - r2 * inv_r2;
   if (t <= 0) return {};
   return {t * t * t, -3.0 * t * t * inv_r2};
+}
+
+// The same from 1/R^2 (what the neighbour loop keeps per term).
+inline KernelWeight smooth_kernel_inv(double r2, double inv_radius2) {
+  return smooth_kernel(r2, 1.0 / std::sqrt(inv_radius2));
 }
 
 }  // namespace kf

@@ -3,20 +3,15 @@
 #include <cmath>
 #include <cstdint>
 
+#include "core/hash.h"
+
 namespace kf {
 
 namespace {
 
-uint64_t mix(uint64_t z) {
-  z += 0x9E3779B97F4A7C15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
 // Uniform in [-1, 1] from (seed, agent, knot, component).
 double knot_value(unsigned seed, int agent, int64_t knot, int component) {
-  const uint64_t h = mix(mix(mix(uint64_t(seed)) ^ uint64_t(uint32_t(agent))) ^ (uint64_t(knot) * 2 + component));
+  const uint64_t h = mix64(mix64(mix64(uint64_t(seed)) ^ uint64_t(uint32_t(agent))) ^ (uint64_t(knot) * 2 + component));
   return double(h >> 11) * (2.0 / 9007199254740992.0) - 1.0;
 }
 
