@@ -5,12 +5,12 @@ writes one CSV row per run (the JSON the command prints, flattened).
 Usage: scripts/gradcheck_table.py OUT.csv --scenes A.json[,B.json] [--frames 3[,10]] [--dt 1/30[,1/60]]
                                   [--perturb 0[,0.01]] [--adjoint exact[,swap]] [--samples N] [--eps E]
                                   [--solver direct|scene]
-Regenerates the gradient tables of the README (see its "Accuracy of the gradients")."""
+KEYFRAME=PATH runs another build. Regenerates the gradient tables of the README (see its "Accuracy of the gradients")."""
 import argparse, csv, itertools, json, os, subprocess, sys
 from fractions import Fraction
 
 here = os.path.dirname(os.path.abspath(__file__))
-keyframe = os.path.join(here, "..", "build", "release", "keyframe")
+keyframe = os.environ.get("KEYFRAME", os.path.join(here, "..", "build", "release", "keyframe"))
 p = argparse.ArgumentParser()
 p.add_argument("out")
 p.add_argument("--scenes", required=True)

@@ -14,8 +14,8 @@ namespace kf {
 void add_gradcheck_command(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "gradcheck",
-      "compare the adjoint gradient with central finite differences on a sample of control coordinates (steps eps, "
-      "eps/2, eps/4, ... Richardson-extrapolated, until two extrapolations agree or the objective's round-off "
+      "compare the adjoint gradient with central finite differences on a sample of control coordinates (steps 4 "
+      "eps, 2 eps, eps, eps/2, ... Richardson-extrapolated, until two extrapolations agree or the objective's round-off "
       "takes over); samples whose estimates never agree to --kink-tolerance straddle a kink of the objective and "
       "are counted as kinks, not as adjoint error; fd_spread is the check's own resolution; prints one JSON "
       "object (checked, kinks, max_rel_error, cosine, rel_error_norm, fd_spread, phi_noise, ...)");
@@ -30,7 +30,7 @@ void add_gradcheck_command(CLI::App& app) {
   auto o = std::make_shared<Options>();
   sub->add_option("SCENE", o->scene, "scene file (JSON)")->required();
   sub->add_option("--samples", o->samples, "coordinates to compare")->check(CLI::Range(1, 100000));
-  sub->add_option("--eps", o->eps, "the first (largest) finite-difference step, relative to max(1, |z|)")
+  sub->add_option("--eps", o->eps, "the finite-difference step completing the first extrapolation (steps start at 4 eps), relative to max(1, |z|)")
       ->check(CLI::Range(1e-12, 1.0))
       ->capture_default_str();
   sub->add_option("--kink-tolerance", o->kink_tolerance,

@@ -100,7 +100,9 @@ GradcheckResult gradcheck(Problem& problem, const VecX& z, const GradcheckOption
   const int m = int(picks.size());
   VecX spread(m), fd(m);
   for (int s = 0; s < m; ++s) {
-    const double step = o.eps * std::max(1.0, std::abs(z[picks[s]]));
+    // From 4 eps, so the first extrapolation, of steps 2 eps and eps, is complete at eps: where φ's
+    // round-off dominates (small components of a large objective) the larger steps are the better ones.
+    const double step = 4 * o.eps * std::max(1.0, std::abs(z[picks[s]]));
     const DifferenceEstimate e =
         extrapolated_difference(step, [&](double h) { return central(picks[s], h); }, kResolution, r.phi_noise);
     fd[s] = e.value;

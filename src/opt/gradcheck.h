@@ -1,11 +1,11 @@
 #pragma once
 // The adjoint gradient against central finite differences on a sample of control coordinates.
 //
-// Each sampled coordinate gets central differences at steps eps, eps/2, eps/4, ... (relative to
+// Each sampled coordinate gets central differences at steps 4 eps, 2 eps, eps, eps/2, ... (relative to
 // max(1, |z_i|)); each adjacent pair is Richardson-extrapolated, and three times the change between two
 // successive extrapolations plus their round-off (phi_noise / step) is the estimate's error. The steps
 // shrink until that error is below 1e-9 of the value, or until φ's round-off explains the changes for
-// three levels in a row, or to eps/2^15; the best estimate is kept. So the check adapts to φ's curvature (a stiff contact can need steps a hundred times below eps
+// three levels in a row, or to eps/2^13; the best estimate is kept. So the check adapts to φ's curvature (a stiff contact can need steps a hundred times below eps
 // before the differences converge) and to φ's round-off (which floors any fixed small step). Where a kink
 // or a jump of φ (a contact feature changing, a step split differently) lies within every step the
 // estimates never agree, and a sample whose relative error estimate exceeds kink_tolerance is counted as
@@ -22,7 +22,7 @@ namespace kf {
 
 struct GradcheckOptions {
   int samples = 40;
-  double eps = 1e-4;              // the first (largest) step, relative to max(1, |z_i|)
+  double eps = 1e-4;              // the step completing the first extrapolation (differences start at 4 eps)
   double kink_tolerance = 1e-2;   // relative error estimate beyond which a sample is a kink
   unsigned seed = 7;
 };
