@@ -10,6 +10,11 @@ struct NotReady : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Thrown by `compare` when some frame fails its thresholds (reports are written); exits with kExitDifferent.
+struct FramesDiffer : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 void add_simulate_command(CLI::App& app);
 void add_optimize_command(CLI::App& app);
 void add_run_command(CLI::App& app);
@@ -19,5 +24,6 @@ void add_figure_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_clip_command(CLI::App& app);
 void add_export_command(CLI::App& app);
+void add_compare_command(CLI::App& app);
 
 }  // namespace kf

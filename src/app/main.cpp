@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   add_bench_command(app);
   add_clip_command(app);
   add_export_command(app);
+  add_compare_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -40,6 +41,9 @@ int main(int argc, char** argv) {
   } catch (const OutputError& e) {
     std::cerr << "keyframe: error: " << e.what() << "\n";
     return kExitOutput;
+  } catch (const FramesDiffer& e) {
+    std::cerr << "keyframe: " << e.what() << "\n";
+    return kExitDifferent;
   } catch (const NotReady& e) {
     std::cerr << "keyframe: " << e.what() << "\n";
     return kExitNotReady;

@@ -8,6 +8,7 @@ namespace kf {
 // Exit codes of the keyframe command (documented in README.md).
 enum ExitCode : int {
   kExitOk = 0,
+  kExitDifferent = 1,    // keyframe compare: some frame differs from its reference beyond the thresholds
   kExitUsage = 2,        // bad command line
   kExitInput = 3,        // bad scene file, asset or run directory
   kExitOutput = 4,       // an output could not be written
