@@ -73,7 +73,7 @@ CompareThresholds noise_thresholds() {
   CompareThresholds t;
   t.tolerance = 48;
   t.max_fraction = 0.01;
-  t.max_mean = 2.0;
+  t.max_mean = 3.0;
   return t;
 }
 

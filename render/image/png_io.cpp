@@ -18,6 +18,15 @@ void append_bytes(png_structp png, png_bytep data, png_size_t n) {
   out->append(reinterpret_cast<const char*>(data), n);
 }
 void no_flush(png_structp) {}
+
+// libpng prints errors and warnings to stderr by default; keyframe reports one line of its own instead,
+// quoting libpng's reason (kept in the error pointer's buffer).
+[[noreturn]] void quiet_error(png_structp png, png_const_charp message) {
+  auto* reason = static_cast<std::string*>(png_get_error_ptr(png));
+  if (reason) *reason = message ? message : "";
+  png_longjmp(png, 1);
+}
+void quiet_warning(png_structp, png_const_charp) {}
 }  // namespace
 
 void write_png(const std::filesystem::path& path, const Image& image) {
@@ -45,13 +54,14 @@ Image read_png(const std::filesystem::path& path) {
   if (!f) throw InputError(path.string() + ": cannot open PNG");
   unsigned char sig[8];
   if (std::fread(sig, 1, 8, f.get()) != 8 || png_sig_cmp(sig, 0, 8)) throw InputError(path.string() + ": not a PNG file");
-  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  std::string reason;
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &reason, quiet_error, quiet_warning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!png || !info) throw InputError(path.string() + ": cannot start PNG decoder");
   Image img;
   if (setjmp(png_jmpbuf(png))) {
     png_destroy_read_struct(&png, &info, nullptr);
-    throw InputError(path.string() + ": corrupt or truncated PNG");
+    throw InputError(path.string() + ": corrupt or truncated PNG (" + (reason.empty() ? "libpng error" : reason) + ")");
   }
   png_init_io(png, f.get());
   png_set_sig_bytes(png, 8);

@@ -19,7 +19,7 @@ void add_compare_command(CLI::App& app) {
   sub->add_option("REFERENCE", req->reference, "directory of reference PNG frames")->required();
   sub->add_flag("--noise", *noise,
                 "tolerate sampling noise (ray-traced frames at other spp or seeds): tolerance 48, max-fraction "
-                "0.01, max-mean 2; explicit threshold options override it");
+                "0.01, max-mean 3; explicit threshold options override it");
   auto* tol = sub->add_option("--tolerance", t.tolerance, "per-pixel, per-channel allowance in 8-bit levels (0..255)")
                   ->capture_default_str();
   auto* frac = sub->add_option("--max-fraction", t.max_fraction, "allowed fraction of pixels over the tolerance (0..1)")

@@ -112,8 +112,8 @@ TEST(Compare, VisibleChangeFailsEvenWithNoiseAndWritesItsDiff) {
   const auto run = testing::make_flock_run(tmp.path() / "flock");
   const auto ref = render_frames(run, tmp.path() / "ref", "embree", 4);
   const auto actual = render_frames(run, tmp.path() / "spp16", "embree", 16);
-  // Frame 2 shows frame 4's agents: the flock has moved.
-  fs::copy_file(actual / "frame_0004.png", actual / "frame_0002.png", fs::copy_options::overwrite_existing);
+  // Frame 2 shows frame 5's agents: the flock has turned by 1.2 rad about the origin.
+  fs::copy_file(actual / "frame_0005.png", actual / "frame_0002.png", fs::copy_options::overwrite_existing);
   CompareRequest r;
   r.actual = actual;
   r.reference = ref;
@@ -124,6 +124,7 @@ TEST(Compare, VisibleChangeFailsEvenWithNoiseAndWritesItsDiff) {
   ASSERT_EQ(f.name, "frame_0002.png");
   EXPECT_FALSE(f.pass);
   EXPECT_FALSE(f.why.empty());
+  EXPECT_GT(f.metrics.over_fraction, 2 * noise_thresholds().max_fraction);  // not a near miss
   const Image heat = read_png(res.out_dir / "frame_0002_diff.png");
   EXPECT_EQ(heat.width, 96);
   const Image side = read_png(res.out_dir / "frame_0002_side.png");
