@@ -1,5 +1,6 @@
 #pragma once
-// Composing rendered frames into one labelled figure sheet.
+// Composing rendered frames into one typeset figure sheet (Cairo, DejaVu Sans): PNG pixels and a PDF
+// with the same layout whose type stays vector.
 #include <string>
 #include <vector>
 
@@ -8,14 +9,23 @@
 namespace kf::render {
 
 struct FigureRow {
-  std::string label;                  // drawn above the row (e.g. the scene name)
-  std::vector<Image> tiles;           // RGB, all the same size
-  std::vector<std::string> captions;  // one per tile, drawn under it
+  std::string label;                  // set above the row (e.g. the scene name); empty: no label line
+  std::vector<Image> tiles;           // RGB or RGBA, all the same size
+  std::vector<std::string> captions;  // one per tile, set under it
 };
 
-// Rows of tiles on a white sheet with a title, row labels and captions. Tiles of all rows must have
-// one size. Returns RGB.
-Image compose_sheet(const std::string& title, const std::vector<FigureRow>& rows);
+struct FigureSheet {
+  std::string title;         // set at the top; empty: no title line
+  std::vector<FigureRow> rows;
+  std::string caption;       // the figure's caption, set under all rows and wrapped to the sheet's width
+};
+
+// The sheet as RGB pixels: tiles at their own resolution on white. Tiles of all rows must have one size
+// (else std::invalid_argument). Throws OutputError when the font (DejaVu Sans) is not installed.
+Image compose_sheet(const FigureSheet& sheet);
+
+// The same sheet as a one-page PDF (1 tile pixel = 0.75 pt, i.e. 96 dpi; tiles embedded losslessly).
+std::string sheet_pdf(const FigureSheet& sheet);
 
 // Superimposes frames (all one size, same camera) into one image: the last at full strength, earlier
 // ones fainter, each contributing only where it is darker than what is already there (agents and

@@ -46,7 +46,20 @@ std::vector<int> resolve_frames(const RunData& run, const std::vector<int>& requ
 }
 
 std::string frame_caption(const RunData& run, int f) {
-  return "FRAME " + std::to_string(f) + (is_keyframe(run, f) ? " (KEY)" : "");
+  return "Frame " + std::to_string(f) + (is_keyframe(run, f) ? " (keyframe)" : "");
+}
+
+std::string lower_first(std::string s) {
+  if (!s.empty()) s[0] = char(std::tolower(static_cast<unsigned char>(s[0])));
+  return s;
+}
+
+// Labels are set in sentence case: "ring-toss" -> "Ring toss".
+std::string sentence_case(std::string s) {
+  std::replace(s.begin(), s.end(), '-', ' ');
+  std::replace(s.begin(), s.end(), '_', ' ');
+  if (!s.empty()) s[0] = char(std::toupper(static_cast<unsigned char>(s[0])));
+  return s;
 }
 
 }  // namespace
@@ -78,7 +91,7 @@ std::filesystem::path make_figure(const FigureRequest& r) {
     for (int f : frames) images.push_back(renderer.render(f));
     if (r.overlay) {
       tiles[k].push_back(overlay_frames(images));
-      captions[k].push_back("FRAMES " + std::to_string(frames.front()) + "-" + std::to_string(frames.back()));
+      captions[k].push_back("Frames " + std::to_string(frames.front()) + "\u2013" + std::to_string(frames.back()));
     } else {
       tiles[k] = std::move(images);
       for (int f : frames) captions[k].push_back(frame_caption(run, f));
@@ -88,7 +101,7 @@ std::filesystem::path make_figure(const FigureRequest& r) {
   if (!r.columns) {
     // One run: the sheet's title already names it.
     for (size_t k = 0; k < runs.size(); ++k)
-      rows.push_back({runs.size() > 1 ? runs[k].scene.name : "", std::move(tiles[k]), captions[k]});
+      rows.push_back({runs.size() > 1 ? sentence_case(runs[k].scene.name) : "", std::move(tiles[k]), captions[k]});
   } else {
     // Transposed: row i holds every run's i-th tile; each caption names its run (and frame).
     size_t depth = 0;
@@ -102,16 +115,21 @@ std::filesystem::path make_figure(const FigureRequest& r) {
       for (size_t k = 0; k < runs.size(); ++k) {
         if (i >= tiles[k].size()) continue;
         row.tiles.push_back(std::move(tiles[k][i]));
-        row.captions.push_back(same ? runs[k].scene.name : runs[k].scene.name + " " + captions[k][i]);
+        const std::string run_name = sentence_case(runs[k].scene.name);
+        row.captions.push_back(same ? run_name : run_name + ", " + lower_first(captions[k][i]));
       }
       rows.push_back(std::move(row));
     }
   }
   const std::string name = r.name.empty() ? runs.front().scene.name : r.name;
-  const Image sheet = compose_sheet(name, rows);
+  const FigureSheet sheet{r.title.empty() ? sentence_case(runs.front().scene.name) : r.title, std::move(rows),
+                          r.caption};
+  const Image pixels = compose_sheet(sheet);
+  const std::string pdf = sheet_pdf(sheet);
   ensure_directory(r.out_dir);
   const auto path = r.out_dir / (name + ".png");
-  write_png(path, sheet);
+  write_file_atomic(r.out_dir / (name + ".pdf"), pdf);
+  write_png(path, pixels);
   return path;
 }
 

@@ -18,7 +18,9 @@ struct FigureRequest {
   std::vector<int> frames;                      // empty: frame 0, every keyframe, the last frame (at most 6);
                                                 // may hold kLastKeyframe / kLastFrame
   bool columns = false;                         // runs side by side, frames going down
-  std::string name;                             // output file name without .png; empty: first run's scene
+  std::string name;                             // output file name without .png/.pdf; empty: first run's scene
+  std::string title;                            // set above the sheet; empty: the first run's scene name
+  std::string caption;                          // set under the sheet (e.g. the paper's caption); may be empty
   std::filesystem::path out_dir = "out/figures";
   std::string backend = "osmesa";
   int width = 400, height = 300;                // one tile, pixels
@@ -26,7 +28,8 @@ struct FigureRequest {
   bool overlay = false;                         // one superimposed tile per run instead of a strip
 };
 
-// Throws InputError (bad request, run or frame; nothing written) or OutputError. Returns the PNG path.
+// Writes out_dir/NAME.png and, with the same layout and vector type, out_dir/NAME.pdf. Throws InputError
+// (bad request, run or frame; nothing written) or OutputError. Returns the PNG path.
 std::filesystem::path make_figure(const FigureRequest& request);
 
 }  // namespace kf::render

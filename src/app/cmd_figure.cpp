@@ -9,7 +9,7 @@
 namespace kf {
 
 void add_figure_command(CLI::App& app) {
-  auto* sub = app.add_subcommand("figure", "compose a labelled figure sheet (out/figures/NAME.png) from run directories");
+  auto* sub = app.add_subcommand("figure", "compose a typeset figure sheet (out/figures/NAME.png and NAME.pdf) from run directories");
   auto req = std::make_shared<render::FigureRequest>();
   auto frames = std::make_shared<std::string>();
   auto size = std::make_shared<std::string>();
@@ -18,7 +18,9 @@ void add_figure_command(CLI::App& app) {
                   "comma-separated frames, e.g. 0,30,60; 'key' = each run's last keyframe, 'last' = its last "
                   "frame (default: 0, keyframes, last)");
   sub->add_flag("--columns", req->columns, "runs side by side, frames going down (paper figures 1 and 6)");
-  sub->add_option("--name", req->name, "figure name (default: the first run's scene name)");
+  sub->add_option("--name", req->name, "file name without .png/.pdf (default: the first run's scene name)");
+  sub->add_option("--title", req->title, "set above the sheet (default: the first run's scene name)");
+  sub->add_option("--caption", req->caption, "set under the sheet, e.g. the paper's caption");
   sub->add_option("--out-dir", req->out_dir, "where the sheet goes")->capture_default_str();
   sub->add_option("--backend", req->backend, "osmesa | embree")->capture_default_str();
   sub->add_option("--size", *size, "tile size WxH in pixels (default 400x300)");

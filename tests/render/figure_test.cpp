@@ -1,28 +1,50 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "core/error.h"
-#include "render/figure/bitmap_font.h"
+#include "render/figure/figure_sheet.h"
 #include "render/figure/make_figure.h"
 #include "render/image/png_io.h"
 #include "synthetic_runs.h"
 
 namespace kf::render {
 
-TEST(BitmapFont, DrawsInkInsideItsBox) {
-  Image img(60, 20, 3);
-  const uint8_t ink[3] = {255, 255, 255};
-  draw_text(img, 2, 3, "K1", 2, ink);
-  int lit = 0;
-  for (int y = 0; y < img.height; ++y)
+// Rows where some pixel is darker than `level` (type or tiles), from `y0` to `y1` (exclusive).
+int inked_rows(const Image& img, int y0, int y1, int level = 128) {
+  int rows = 0;
+  for (int y = y0; y < y1; ++y)
     for (int x = 0; x < img.width; ++x)
-      if (img.at(x, y)[0]) {
-        ++lit;
-        EXPECT_GE(x, 2);
-        EXPECT_LT(x, 2 + text_width("K1", 2));
-        EXPECT_GE(y, 3);
-        EXPECT_LT(y, 3 + text_height(2));
+      if (img.at(x, y)[0] < level) {
+        ++rows;
+        break;
       }
-  EXPECT_GT(lit, 40);
+  return rows;
+}
+
+TEST(FigureSheet, TypesetsTitleLabelsAndAWrappedCaption) {
+  FigureSheet s;
+  s.title = "Square then cross";
+  Image tile(120, 80, 3);
+  std::fill(tile.pixels.begin(), tile.pixels.end(), uint8_t(230));  // light, so only type is dark
+  s.rows.push_back({"Flock", {tile, tile}, {"Frame 0", "Frame 45 (keyframe)"}});
+  const Image bare = compose_sheet(s);
+  EXPECT_EQ(bare.width, 2 * 16 + 2 * 120 + 10);
+  EXPECT_GT(inked_rows(bare, 0, 40), 8);  // the title's type
+  s.caption = "Fig. 1 left: 200 agents form a square (frame 45) then a cross (frame 90); a caption this long "
+              "wraps onto more than one line under the figure.";
+  const Image captioned = compose_sheet(s);
+  EXPECT_EQ(captioned.width, bare.width);  // the caption wraps instead of widening the sheet
+  EXPECT_GT(captioned.height, bare.height + 2 * 15);  // at least two lines
+  EXPECT_GT(inked_rows(captioned, bare.height - 16, captioned.height), 15);
+  EXPECT_EQ(inked_rows(bare, bare.height - 12, bare.height), 0);  // a white margin at the bottom
+
+  const std::string pdf = sheet_pdf(s);
+  ASSERT_GT(pdf.size(), 1000u);
+  EXPECT_EQ(pdf.substr(0, 5), "%PDF-");
+  EXPECT_NE(pdf.find("DejaVu"), std::string::npos);  // type embedded as a font, not pixels
+  s.rows[0].tiles.push_back(Image(60, 80, 3));
+  EXPECT_THROW(compose_sheet(s), std::invalid_argument);
 }
 
 TEST(Figure, StripOfTwoRunsAndOverlay) {
@@ -36,6 +58,7 @@ TEST(Figure, StripOfTwoRunsAndOverlay) {
   r.name = "sheet";
   const auto path = make_figure(r);
   EXPECT_EQ(path, tmp.path() / "figures/sheet.png");
+  EXPECT_GT(std::filesystem::file_size(tmp.path() / "figures/sheet.pdf"), 1000u);  // beside the PNG
   const Image sheet = read_png(path);
   EXPECT_GT(sheet.width, 3 * 80);
   EXPECT_GT(sheet.height, 2 * 60);
@@ -48,6 +71,7 @@ TEST(Figure, StripOfTwoRunsAndOverlay) {
   r.name = "bad";
   EXPECT_THROW(make_figure(r), InputError);
   EXPECT_FALSE(std::filesystem::exists(tmp.path() / "figures/bad.png"));
+  EXPECT_FALSE(std::filesystem::exists(tmp.path() / "figures/bad.pdf"));
 }
 
 TEST(Figure, ColumnsPutRunsSideBySideAtTheirLastKeyframe) {
