@@ -7,6 +7,8 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 
 #include "core/error.h"
 #include "core/mesh_sequence.h"
@@ -53,22 +55,57 @@ TEST(Clip, NoFramesNamesTheRenderCommand) {
   EXPECT_FALSE(find_program("sh").empty());
 }
 
-TEST(Clip, EncodesFramesWhenFfmpegIsInstalled) {
-  if (find_program("ffmpeg").empty()) GTEST_SKIP() << "ffmpeg not installed";
+// Frames in a video file as ffprobe counts them by decoding; -1 when it cannot tell.
+int decoded_frames(const fs::path& video) {
+  const fs::path ffprobe = find_program("ffprobe");
+  if (ffprobe.empty()) return -1;
+  const std::string cmd = "'" + ffprobe.string() + "' -v error -count_frames -select_streams v:0 "
+                          "-show_entries stream=nb_read_frames -of csv=p=0 '" + video.string() + "'";
+  FILE* p = popen(cmd.c_str(), "r");
+  char buf[64] = {0};
+  const size_t n = p ? fread(buf, 1, sizeof buf - 1, p) : 0;
+  if (p) pclose(p);
+  return n > 0 ? std::atoi(buf) : -1;
+}
+
+// scripts/setup installs ffmpeg, so CI (CI=true) must encode; elsewhere a missing ffmpeg skips.
+bool ffmpeg_or_skip() {
+  if (!find_program("ffmpeg").empty()) return true;
+  if (std::getenv("CI")) ADD_FAILURE() << "ffmpeg not installed; scripts/setup installs it";
+  return false;
+}
+
+TEST(Clip, EncodesFramesAndATurntableAsMp4AndGif) {
+  if (!ffmpeg_or_skip()) GTEST_SKIP() << "ffmpeg not installed";
   testing::TempDir tmp;
   const auto run = testing::make_flock_run(tmp.path() / "flock");
   RenderRequest rr;
   rr.run_dir = run;
   rr.width = 65;  // odd on purpose: H.264 needs even sides
   rr.height = 48;
-  render_run(rr);
+  EXPECT_EQ(render_run(rr), 6);
+  rr.turntable = 8;
+  EXPECT_EQ(render_run(rr), 8);
   ClipRequest r;
   r.run_dir = run;
   r.gif = true;
   const auto files = make_clip(r);
   ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(files[0], run / "clip.mp4");
+  EXPECT_EQ(files[1], run / "clip.gif");
   for (const auto& f : files) EXPECT_GT(fs::file_size(f), 100u) << f;
   EXPECT_FALSE(fs::exists(run / "clip.mp4.partial"));
+  r.turntable = true;
+  const auto turn = make_clip(r);
+  ASSERT_EQ(turn.size(), 2u);
+  EXPECT_EQ(turn[0], run / "turntable.mp4");
+  EXPECT_EQ(turn[1], run / "turntable.gif");
+  if (!find_program("ffprobe").empty()) {
+    EXPECT_EQ(decoded_frames(run / "clip.mp4"), 6);
+    EXPECT_EQ(decoded_frames(run / "clip.gif"), 6);
+    EXPECT_EQ(decoded_frames(run / "turntable.mp4"), 8);
+    EXPECT_EQ(decoded_frames(run / "turntable.gif"), 8);
+  }
 }
 
 // Vertex count of every mesh assimp finds in `file`, by mesh name.
