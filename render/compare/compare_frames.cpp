@@ -131,7 +131,8 @@ CompareResult compare_frames(const CompareRequest& r) {
       f.metrics = image_metrics(a, b, t.tolerance);
       f.why = threshold_failure(f.metrics, t);
     } else {
-      f.why = "no reference frame";
+      f.is_new = true;
+      ++res.added;
     }
     f.pass = f.why.empty();
     res.failed += !f.pass;
@@ -142,7 +143,7 @@ CompareResult compare_frames(const CompareRequest& r) {
   ensure_directory(res.out_dir);
   remove_old_diffs(res.out_dir);
   for (auto& f : res.frames) {
-    if (f.pass || !ref_names.count(f.name)) continue;
+    if (f.pass) continue;
     const Image a = read_png(actual / f.name), b = read_png(reference / f.name);
     const std::string stem = fs::path(f.name).stem().string();
     f.diff = stem + "_diff.png";
@@ -154,7 +155,7 @@ CompareResult compare_frames(const CompareRequest& r) {
   if (r.update) {
     ensure_directory(reference);
     for (const auto& f : res.frames) {
-      if (ref_names.count(f.name) && f.metrics.max_abs == 0) continue;  // the same pixels already
+      if (!f.is_new && f.metrics.max_abs == 0) continue;  // the same pixels already
       write_file_atomic(reference / f.name, read_bytes(actual / f.name));
       ++res.updated;
     }

@@ -35,13 +35,15 @@ struct FrameResult {
   int width = 0, height = 0;
   ImageMetrics metrics;
   bool pass = true;
+  bool is_new = false;         // no reference yet (only with `update`, which adds it); neither pass nor fail
   std::string why;             // for a failing frame: which threshold it broke, with the values
   std::string diff, side;      // for a failing frame: heat map and side-by-side file names in out_dir
 };
 
 struct CompareResult {
   std::vector<FrameResult> frames;  // by name
-  int failed = 0;
+  int failed = 0;                   // frames with a reference that break a threshold
+  int added = 0;                    // frames without a reference (only with `update`)
   std::filesystem::path out_dir, json, junit;  // where the reports went
   int updated = 0;                  // references written by `update`
 };

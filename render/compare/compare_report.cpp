@@ -42,6 +42,7 @@ std::string compare_json(const CompareRequest& r, const CompareResult& res) {
                      {"min_psnr_db", t.min_psnr}};
   j["frames_compared"] = res.frames.size();
   j["frames_failed"] = res.failed;
+  j["frames_new"] = res.added;
   j["references_updated"] = res.updated;
   j["frames"] = json::array();
   for (const auto& f : res.frames) {
@@ -50,6 +51,7 @@ std::string compare_json(const CompareRequest& r, const CompareResult& res) {
               {"width", f.width},
               {"height", f.height},
               {"pass", f.pass},
+              {"new", f.is_new},
               {"max_abs", m.max_abs},
               {"mean_abs", m.mean_abs},
               {"rmse", m.rmse},
@@ -71,11 +73,15 @@ std::string compare_junit(const CompareRequest& r, const CompareResult& res) {
   const std::string cls = xml_escape("compare." + r.reference.filename().string());
   std::string x = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   const std::string counts = " tests=\"" + std::to_string(res.frames.size()) + "\" failures=\"" +
-                             std::to_string(res.failed) + "\" errors=\"0\"";
+                             std::to_string(res.failed) + "\" errors=\"0\" skipped=\"" + std::to_string(res.added) + "\"";
   x += "<testsuites name=\"keyframe compare\"" + counts + ">\n";
-  x += "  <testsuite name=\"" + suite + "\"" + counts + " skipped=\"0\">\n";
+  x += "  <testsuite name=\"" + suite + "\"" + counts + ">\n";
   for (const auto& f : res.frames) {
     x += "    <testcase classname=\"" + cls + "\" name=\"" + xml_escape(f.name) + "\"";
+    if (f.is_new) {
+      x += ">\n      <skipped message=\"no reference frame; added by --update\"/>\n    </testcase>\n";
+      continue;
+    }
     if (f.pass) {
       x += "/>\n";
       continue;

@@ -43,8 +43,9 @@ void add_compare_command(CLI::App& app) {
       if (!f.pass)
         std::cout << "FAIL " << f.name << ": " << f.why << (f.diff.empty() ? "" : " -> " + (res.out_dir / f.side).string())
                   << "\n";
-    std::cout << "compare: " << res.frames.size() << " frames, " << res.frames.size() - res.failed << " pass, "
-              << res.failed << " fail -> " << res.json.string() << ", " << res.junit.string() << "\n";
+    std::cout << "compare: " << res.frames.size() << " frames, " << res.frames.size() - res.failed - res.added
+              << " pass, " << res.failed << " fail" << (res.added ? ", " + std::to_string(res.added) + " new" : "")
+              << " -> " << res.json.string() << ", " << res.junit.string() << "\n";
     if (r.update) {
       std::cout << "compare: " << res.updated << " reference frames written to " << r.reference.string() << "\n";
       return;

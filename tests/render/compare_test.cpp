@@ -159,7 +159,11 @@ TEST(Compare, UpdateReplacesReferencesOnlyWhenAsked) {
   r.reference = tmp.path() / "fresh";
   EXPECT_THROW(compare_frames(r), InputError);
   r.update = true;
-  EXPECT_EQ(compare_frames(r).updated, 6);
+  const CompareResult fresh = compare_frames(r);
+  EXPECT_EQ(fresh.updated, 6);
+  EXPECT_EQ(fresh.added, 6);  // new frames are neither passes nor failures
+  EXPECT_EQ(fresh.failed, 0);
+  EXPECT_NE(slurp(fresh.junit).find("<skipped message="), std::string::npos);
   EXPECT_TRUE(fs::exists(tmp.path() / "fresh/frame_0005.png"));
 }
 
