@@ -140,6 +140,10 @@ CompareResult compare_frames(const CompareRequest& r) {
   }
 
   res.out_dir = !r.out_dir.empty() ? r.out_dir : fs::weakly_canonical(actual, ec).parent_path() / "compare";
+  // Diff images among the frames would be paired as frames next time.
+  for (const fs::path& d : {actual, reference})
+    if (fs::weakly_canonical(res.out_dir, ec) == fs::weakly_canonical(d, ec))
+      throw InputError(res.out_dir.string() + ": reports cannot go into a frames directory (choose another --out)");
   ensure_directory(res.out_dir);
   remove_old_diffs(res.out_dir);
   for (auto& f : res.frames) {

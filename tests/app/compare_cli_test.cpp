@@ -88,6 +88,7 @@ TEST_F(CompareCli, BadInputExitsThreeWithOneLine) {
       {"compare cut ref", "corrupt or truncated PNG"},
       {"compare empty ref", "no PNG frames to compare"},
       {"compare ref empty", "no PNG reference frames"},
+      {"compare ref ref --out ref", "reports cannot go into a frames directory"},
   };
   for (const auto& [args, message] : cases) {
     const auto r = run_keyframe(args, dir_);

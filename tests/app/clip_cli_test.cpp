@@ -1,0 +1,44 @@
+// keyframe clip from the command line, as the README shows it: render, then encode frames and a turntable.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+
+#include "../reliability/cli_harness.h"
+#include "../render/synthetic_runs.h"
+#include "core/error.h"
+#include "render/clip/make_clip.h"
+
+namespace kf {
+namespace {
+
+namespace fs = std::filesystem;
+using reliability::run_keyframe;
+
+class ClipCli : public reliability::TempDirTest {};
+
+TEST_F(ClipCli, RenderThenClipMp4GifAndTurntable) {
+  if (render::find_program("ffmpeg").empty()) {
+    // scripts/setup installs ffmpeg, so CI (CI=true) must encode.
+    if (std::getenv("CI")) FAIL() << "ffmpeg not installed; scripts/setup installs it";
+    GTEST_SKIP() << "ffmpeg not installed";
+  }
+  render::testing::make_flock_run(dir_ / "flock");
+  auto r = run_keyframe("render flock --size 64x48", dir_);
+  ASSERT_EQ(r.code, kExitOk) << r.output;
+  r = run_keyframe("clip flock --gif", dir_);
+  ASSERT_EQ(r.code, kExitOk) << r.output;
+  EXPECT_NE(r.output.find("clip -> flock/clip.mp4"), std::string::npos) << r.output;
+  EXPECT_GT(fs::file_size(dir_ / "flock/clip.mp4"), 100u);
+  EXPECT_GT(fs::file_size(dir_ / "flock/clip.gif"), 100u);
+  r = run_keyframe("render flock --size 64x48 --turntable 10", dir_);
+  ASSERT_EQ(r.code, kExitOk) << r.output;
+  r = run_keyframe("clip flock --turntable --gif-only", dir_);
+  ASSERT_EQ(r.code, kExitOk) << r.output;
+  EXPECT_GT(fs::file_size(dir_ / "flock/turntable.gif"), 100u);
+  EXPECT_FALSE(fs::exists(dir_ / "flock/turntable.mp4"));  // --gif-only
+  r = run_keyframe("clip flock --ffmpeg /nonexistent/ffmpeg", dir_);
+  EXPECT_EQ(r.code, kExitNotReady) << r.output;
+}
+
+}  // namespace
+}  // namespace kf
