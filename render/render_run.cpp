@@ -12,6 +12,7 @@ namespace kf::render {
 
 namespace {
 constexpr int kMaxSize = 8192;
+}  // namespace
 
 void check_request(const RenderRequest& r) {
   bool known = false;
@@ -25,8 +26,12 @@ void check_request(const RenderRequest& r) {
     throw InputError("samples per pixel " + std::to_string(r.spp) + " out of range (1..65536)");
   if (r.turntable < 0 || r.turntable > 100000)
     throw InputError("turntable frame count " + std::to_string(r.turntable) + " out of range (1..100000)");
+  const int views_end = r.view_end < 0 ? r.turntable : r.view_end;
+  if ((r.view_begin != 0 || r.view_end >= 0) && (r.view_begin < 0 || views_end <= r.view_begin || views_end > r.turntable))
+    throw InputError("views " + std::to_string(r.view_begin) + ":" + std::to_string(r.view_end) +
+                     " out of range: the turntable has views 0.." + std::to_string(r.turntable - 1) +
+                     " (A:B renders A..B-1; needs --turntable)");
 }
-}  // namespace
 
 int render_run(const RenderRequest& request) {
   check_request(request);
@@ -41,14 +46,18 @@ int render_run(const RenderRequest& request) {
   const auto dir = request.run_dir / "frames";
   ensure_directory(dir);
   const bool turntable = request.turntable > 0;
-  const int count = turntable ? request.turntable : end - begin;
+  // A turntable may be rendered a range of views at a time (farm tasks); the orbit angle uses all views.
+  const int first = turntable ? request.view_begin : 0;
+  const int last = turntable ? (request.view_end < 0 ? request.turntable : request.view_end) : end - begin;
+  const int count = last - first;
   Progress progress("render " + request.backend, count);
   char name[64];
-  for (int k = 0; k < count; ++k) {
-    const Image img = turntable ? renderer.render(begin, 2.0 * M_PI * k / count) : renderer.render(begin + k);
+  for (int k = first; k < last; ++k) {
+    const Image img =
+        turntable ? renderer.render(begin, 2.0 * M_PI * k / request.turntable) : renderer.render(begin + k);
     std::snprintf(name, sizeof name, turntable ? "turntable_%04d.png" : "frame_%04d.png", turntable ? k : begin + k);
     write_png(dir / name, img);
-    progress.update(k + 1, name);
+    progress.update(k - first + 1, name);
   }
   progress.finish();
   return count;

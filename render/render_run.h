@@ -13,7 +13,11 @@ struct RenderRequest {
   int frame_begin = 0;             // first frame to render
   int frame_end = -1;              // one past the last, -1: all
   int turntable = 0;               // >0: this many frames orbiting frame_begin instead
+  int view_begin = 0, view_end = -1;  // with turntable: render views view_begin..view_end-1 only (-1: all)
 };
+
+// Throws InputError for a request out of range (backend, size, samples, turntable); reads no files.
+void check_request(const RenderRequest& request);
 
 // Throws InputError for a bad request or run directory (before writing anything), OutputError when
 // a frame cannot be written. Returns the number of frames written.

@@ -25,5 +25,6 @@ void add_bench_command(CLI::App& app);
 void add_clip_command(CLI::App& app);
 void add_export_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
+void add_farm_command(CLI::App& app);
 
 }  // namespace kf

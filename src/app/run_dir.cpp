@@ -21,9 +21,15 @@ void prepare_run_dir(const fs::path& dir, const Scene& scene) {
   os << in.rdbuf();
   // Keep the scene's name: the copy is read back with the run directory's scene name.
   auto j = nlohmann::json::parse(os.str());
-  // A character's mesh and a cape's start and target runs are named relative to the scene's directory;
-  // the copy names them absolutely so it reads the same from the run directory (render, resume).
-  const fs::path base = fs::absolute(scene.directory.empty() ? fs::path(".") : scene.directory);
+  // The copy names assets absolutely so it reads the same from the run directory (render, resume).
+  absolutise_scene_paths(j, scene.directory);
+  write_file_atomic(dir / "scene.json", j.dump(2) + "\n");
+  write_file_atomic(dir / "scene_name.txt", scene.name + "\n" + fs::absolute(scene.directory.empty() ? fs::path(".") : scene.directory).string() + "\n");
+}
+
+void absolutise_scene_paths(nlohmann::json& j, const fs::path& scene_dir) {
+  // A character's mesh and a cape's start and target runs are named relative to the scene's directory.
+  const fs::path base = fs::absolute(scene_dir.empty() ? fs::path(".") : scene_dir);
   auto absolutise = [&](nlohmann::json& parent, const char* key) {
     if (parent.is_object() && parent.contains(key) && parent[key].is_string())
       parent[key] = (base / parent[key].get<std::string>()).lexically_normal().string();
@@ -34,8 +40,6 @@ void prepare_run_dir(const fs::path& dir, const Scene& scene) {
     if (c.contains("start")) absolutise(c["start"], "run");
     if (c.contains("end_target")) absolutise(c["end_target"], "run");
   }
-  write_file_atomic(dir / "scene.json", j.dump(2) + "\n");
-  write_file_atomic(dir / "scene_name.txt", scene.name + "\n" + fs::absolute(scene.directory.empty() ? fs::path(".") : scene.directory).string() + "\n");
 }
 
 Scene load_run_scene(const fs::path& dir) {

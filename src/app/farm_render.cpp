@@ -1,0 +1,150 @@
+#include "app/farm_render.h"
+
+#include <cstdio>
+
+#include "core/error.h"
+#include "render/frame_renderer.h"
+#include "render/image/png_io.h"
+
+namespace kf::farm {
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path frame_path(const fs::path& run_dir, int k, bool turntable) {
+  char name[64];
+  std::snprintf(name, sizeof name, turntable ? "turntable_%04d.png" : "frame_%04d.png", k);
+  return run_dir / "frames" / name;
+}
+
+std::string range_text(int first, int last) { return std::to_string(first) + ":" + std::to_string(last); }
+
+}  // namespace
+
+std::vector<Range> plan_chunks(const std::vector<int>& todo, int chunk) {
+  std::vector<Range> chunks;
+  for (int k : todo) {
+    if (chunks.empty() || chunks.back().last != k || chunks.back().last - chunks.back().first >= chunk)
+      chunks.push_back({k, k + 1});
+    else
+      chunks.back().last = k + 1;
+  }
+  return chunks;
+}
+
+FrameState frame_state(const fs::path& png, int width, int height) {
+  std::error_code ec;
+  if (!fs::is_regular_file(png, ec)) return FrameState::missing;
+  try {
+    const render::Image img = render::read_png(png);
+    if (width > 0 && (img.width != width || img.height != height)) return FrameState::wrong_size;
+  } catch (const InputError&) {
+    return FrameState::not_png;
+  }
+  return FrameState::complete;
+}
+
+const char* describe(FrameState s) {
+  switch (s) {
+    case FrameState::complete: return "complete";
+    case FrameState::missing: return "missing";
+    case FrameState::not_png: return "not a readable PNG";
+    case FrameState::wrong_size: return "of another size";
+  }
+  return "?";
+}
+
+RenderPlan plan_render_farm(const RenderFarm& farm) {
+  const render::RenderRequest& r = farm.request;
+  if (farm.chunk < 1)
+    throw InputError("--chunk: expected at least 1 frame per task, got " + std::to_string(farm.chunk));
+  render::check_request(r);
+  slurm::check(farm.slurm);
+  const render::RunData run = render::load_run(r.run_dir);
+  const int F = run.trajectory.frames();
+  const int end = r.frame_end < 0 ? F : r.frame_end;
+  if (r.frame_begin < 0 || r.frame_begin >= F || end <= r.frame_begin || end > F)
+    throw InputError("--frames " + range_text(r.frame_begin, r.frame_end) + " out of range: " + r.run_dir.string() +
+                     " has frames 0.." + std::to_string(F - 1) + " (A:B renders A..B-1)");
+
+  RenderPlan plan;
+  plan.name = r.run_dir.filename().string();
+  plan.turntable = r.turntable > 0;
+  plan.first = plan.turntable ? 0 : r.frame_begin;
+  plan.last = plan.turntable ? r.turntable : end;
+  plan.width = r.width > 0 ? r.width : run.scene.render.width;
+  plan.height = r.height > 0 ? r.height : run.scene.render.height;
+  plan.farm_dir = r.run_dir / "farm";
+  std::vector<int> todo;
+  for (int k = plan.first; k < plan.last; ++k)
+    if (frame_state(frame_path(r.run_dir, k, plan.turntable), plan.width, plan.height) != FrameState::complete)
+      todo.push_back(k);
+  plan.complete = plan.last - plan.first - int(todo.size());
+  plan.chunks = plan_chunks(todo, farm.chunk);
+
+  const std::string kf = slurm::shell_quote(farm.keyframe.string());
+  const std::string dir = slurm::shell_quote(r.run_dir.string());
+  const std::string logs = slurm::shell_quote((plan.farm_dir / "logs").string());
+  const std::string what = plan.turntable ? "turntable views" : "frames";
+  const std::string size = std::to_string(plan.width) + "x" + std::to_string(plan.height);
+
+  // The array: task i renders chunks[i].
+  std::string chunks;
+  for (const auto& c : plan.chunks) chunks += (chunks.empty() ? "" : " ") + range_text(c.first, c.last);
+  std::string s = "#!/bin/bash\n";
+  s += "# keyframe farm render: " + what + " " + std::to_string(plan.first) + ".." + std::to_string(plan.last - 1) +
+       " of " + r.run_dir.string() + ", " + std::to_string(todo.size()) + " to render in " +
+       std::to_string(plan.chunks.size()) + " tasks (" + r.backend + ", " + size + ")\n";
+  s += "#SBATCH --job-name=keyframe-render-" + plan.name + "\n";
+  s += "#SBATCH --array=0-" + std::to_string(int(plan.chunks.size()) - 1) + "\n";
+  s += "#SBATCH --output=" + logs + "/render-%A_%a.out\n";
+  s += slurm::sbatch_lines(farm.slurm);
+  s += "set -euo pipefail\n";
+  s += "chunks=(" + chunks + ")\n";
+  s += "exec " + kf + " --threads \"${SLURM_CPUS_PER_TASK:-0}\" render " + dir;
+  if (plan.turntable)
+    s += " --frames " + std::to_string(r.frame_begin) + " --turntable " + std::to_string(r.turntable) +
+         " --views \"${chunks[$SLURM_ARRAY_TASK_ID]}\" \\\n  ";
+  else
+    s += " --frames \"${chunks[$SLURM_ARRAY_TASK_ID]}\" \\\n  ";
+  s += "--backend " + slurm::shell_quote(r.backend) + " --size " + size;
+  if (r.spp > 0) s += " --spp " + std::to_string(r.spp);
+  s += "\n";
+  plan.render_script = s;
+
+  // The check: runs once every task has succeeded (afterok on the command line).
+  s = "#!/bin/bash\n";
+  s += "# keyframe farm render: check " + what + " " + std::to_string(plan.first) + ".." +
+       std::to_string(plan.last - 1) + " of " + r.run_dir.string() + ", then encode the preview clip\n";
+  s += "#SBATCH --job-name=keyframe-check-" + plan.name + "\n";
+  s += "#SBATCH --output=" + logs + "/check-%j.out\n";
+  s += "#SBATCH --kill-on-invalid-dep=yes\n";
+  s += slurm::sbatch_lines(farm.slurm);
+  s += "set -euo pipefail\n";
+  s += kf + " farm check " + dir +
+       (plan.turntable ? " --turntable " + std::to_string(r.turntable)
+                       : " --frames " + range_text(plan.first, plan.last)) +
+       " --size " + size + "\n";
+  s += "if command -v ffmpeg >/dev/null; then " + kf + " clip " + dir + (plan.turntable ? " --turntable" : "") +
+       "; else echo \"no ffmpeg on $(hostname): no clip\"; fi\n";
+  plan.check_script = s;
+  return plan;
+}
+
+int check_frames(const fs::path& run_dir, int first, int last, bool turntable, int width, int height) {
+  std::string bad;
+  int count = 0;
+  for (int k = first; k < last; ++k) {
+    const fs::path png = frame_path(run_dir, k, turntable);
+    const FrameState s = frame_state(png, width, height);
+    if (s == FrameState::complete) continue;
+    if (++count <= 4) bad += (bad.empty() ? "" : ", ") + png.filename().string() + " " + describe(s);
+  }
+  if (count > 0)
+    throw InputError((run_dir / "frames").string() + ": " + std::to_string(count) + " of " +
+                     std::to_string(last - first) + (turntable ? " turntable views" : " frames") +
+                     " not complete (" + bad + (count > 4 ? ", ..." : "") + ")");
+  return last - first;
+}
+
+}  // namespace kf::farm

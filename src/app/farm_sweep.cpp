@@ -1,0 +1,276 @@
+#include "app/farm_sweep.h"
+
+#include <cctype>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "app/plot.h"
+#include "app/run_dir.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "scene/scene.h"
+
+namespace kf::farm {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+std::string read_all(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+// JSON's kinds as a user names them; all numbers are one kind.
+std::string kind(const json& j) {
+  if (j.is_number()) return "number";
+  if (j.is_boolean()) return "boolean";
+  if (j.is_string()) return "string";
+  if (j.is_array()) return "array";
+  if (j.is_object()) return "object";
+  return "null";
+}
+
+// A value or name as a CSV cell or a directory name: no separators, quotes or line breaks.
+std::string plain(const std::string& s, const std::string& allowed) {
+  std::string out;
+  for (char c : s) out += std::isalnum(static_cast<unsigned char>(c)) || allowed.find(c) != std::string::npos ? c : '_';
+  return out;
+}
+
+std::string cell(const json& j) {
+  if (j.is_null()) return "";
+  if (j.is_string()) return plain(j.get<std::string>(), " .:;+-_=()/");
+  return plain(j.dump(), ".+-_[];:");
+}
+
+}  // namespace
+
+Sweep parse_sweep(const std::string& text) {
+  const auto bad = [&](const std::string& why) {
+    return InputError("--sweep " + text + ": " + why + " (expected KEY=V1,V2,... with KEY a JSON pointer into the scene, "
+                      "e.g. /cloth/stretch=500,2000)");
+  };
+  const size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0 || text[0] != '/') throw bad("no key");
+  Sweep s;
+  s.key = text.substr(0, eq);
+  try {
+    (void)json::json_pointer(s.key);
+  } catch (const json::exception&) {
+    throw bad("\"" + s.key + "\" is not a JSON pointer");
+  }
+  // Split the values at top-level commas.
+  const std::string list = text.substr(eq + 1);
+  int depth = 0;
+  bool quoted = false;
+  std::string current;
+  std::vector<std::string> words;
+  for (size_t i = 0; i <= list.size(); ++i) {
+    const char c = i < list.size() ? list[i] : ',';
+    if (c == '"' && (i == 0 || list[i - 1] != '\\')) quoted = !quoted;
+    if (!quoted && (c == '[' || c == '{')) ++depth;
+    if (!quoted && (c == ']' || c == '}')) --depth;
+    if (c == ',' && depth == 0 && !quoted) {
+      if (current.empty()) throw bad("an empty value");
+      words.push_back(current);
+      current.clear();
+    } else {
+      current += c;
+    }
+  }
+  for (const auto& w : words) {
+    json v = json::parse(w, nullptr, false);
+    s.values.push_back(v.is_discarded() ? json(w) : v);
+    s.texts.push_back(w);
+  }
+  return s;
+}
+
+std::vector<SweepRun> plan_sweep(const std::vector<fs::path>& scenes, const std::vector<Sweep>& sweeps) {
+  // Run names use each key's last token, or the whole pointer when two keys end alike.
+  std::vector<std::string> labels;
+  std::map<std::string, int> uses;
+  for (const auto& s : sweeps) ++uses[json::json_pointer(s.key).back()];
+  for (const auto& s : sweeps) {
+    const std::string last = json::json_pointer(s.key).back();
+    std::string label = uses[last] > 1 ? s.key.substr(1) : last;
+    for (char& c : label) c = c == '/' ? '.' : c;
+    labels.push_back(plain(label, ".-_"));
+  }
+  std::vector<SweepRun> runs;
+  std::set<std::string> names;
+  for (const auto& file : scenes) {
+    const Scene base = load_scene(file);  // the scene itself first: its own errors read best
+    const json j = json::parse(read_all(file));
+    for (const auto& s : sweeps) {
+      const json::json_pointer ptr(s.key);
+      if (!j.contains(ptr.parent_pointer()) || !(j[ptr.parent_pointer()].is_object() || j[ptr.parent_pointer()].is_array()))
+        throw InputError("--sweep " + s.key + ": " + file.string() + " has no " + ptr.parent_pointer().to_string() +
+                         " block to set " + ptr.back() + " in");
+      if (j.contains(ptr))
+        for (size_t k = 0; k < s.values.size(); ++k)
+          if (kind(s.values[k]) != kind(j[ptr]))
+            throw InputError("--sweep " + s.key + "=" + s.texts[k] + ": " + file.string() + " has a " + kind(j[ptr]) +
+                             " at " + s.key + " (" + j[ptr].dump() + "), got a " + kind(s.values[k]));
+    }
+    // Every point of the grid: the first sweep varies slowest.
+    std::vector<size_t> at(sweeps.size(), 0);
+    for (bool more = true; more;) {
+      SweepRun run;
+      run.scene = base.name;
+      run.name = plain(base.name, ".-_");
+      run.file = j;
+      run.values = json::object();
+      std::string point;
+      for (size_t i = 0; i < sweeps.size(); ++i) {
+        const auto& s = sweeps[i];
+        run.file[json::json_pointer(s.key)] = s.values[at[i]];
+        run.values[s.key] = s.values[at[i]];
+        run.name += "_" + labels[i] + "=" + plain(s.texts[at[i]], ".-+_");
+        point += (point.empty() ? "" : " ") + s.key + "=" + s.texts[at[i]];
+      }
+      absolutise_scene_paths(run.file, base.directory);
+      try {
+        parse_scene(run.file.dump(), file);
+      } catch (const InputError& e) {
+        throw InputError("--sweep " + point + ": " + e.what());
+      }
+      if (!names.insert(run.name).second)
+        throw InputError("two runs would both be named " + run.name + " (the same scene given twice?)");
+      runs.push_back(std::move(run));
+      more = false;
+      for (size_t i = sweeps.size(); i-- > 0;) {
+        if (++at[i] < sweeps[i].values.size()) {
+          more = true;
+          break;
+        }
+        at[i] = 0;
+      }
+    }
+  }
+  return runs;
+}
+
+bool run_finished(const fs::path& run_dir) {
+  std::error_code ec;
+  if (!fs::is_regular_file(run_dir / "report.json", ec)) return false;
+  const json r = json::parse(read_all(run_dir / "report.json"), nullptr, false);
+  return r.is_object() && r.contains("final_objective") && !r.value("interrupted", true);
+}
+
+json sweep_manifest(const SweepFarm& farm) {
+  json m = {{"keys", farm.keys}, {"runs", json::array()}};
+  for (const auto& r : farm.runs) m["runs"].push_back({{"name", r.name}, {"scene", r.scene}, {"values", r.values}});
+  return m;
+}
+
+SweepPlan plan_sweep_farm(const SweepFarm& farm) {
+  slurm::check(farm.slurm);
+  SweepPlan plan;
+  for (size_t k = 0; k < farm.runs.size(); ++k)
+    if (!run_finished(farm.out / farm.runs[k].name)) plan.todo.push_back(k);
+
+  const std::string kf = slurm::shell_quote(farm.keyframe.string());
+  const std::string out = slurm::shell_quote(farm.out.string());
+  const std::string logs = slurm::shell_quote((farm.out / "farm" / "logs").string());
+  const std::string name = farm.out.filename().string();
+  std::string keys;
+  for (const auto& k : farm.keys) keys += (keys.empty() ? "" : ", ") + k;
+  std::string runs;
+  for (size_t k : plan.todo) runs += (runs.empty() ? "" : " ") + farm.runs[k].name;
+
+  std::string s = "#!/bin/bash\n";
+  s += "# keyframe farm optimize: " + std::to_string(plan.todo.size()) + " of " + std::to_string(farm.runs.size()) +
+       " runs" + (keys.empty() ? "" : " over " + keys) + ", each into " + farm.out.string() + "/RUN\n";
+  s += "#SBATCH --job-name=keyframe-optimize-" + name + "\n";
+  s += "#SBATCH --array=0-" + std::to_string(int(plan.todo.size()) - 1) + "\n";
+  s += "#SBATCH --output=" + logs + "/optimize-%A_%a.out\n";
+  s += slurm::sbatch_lines(farm.slurm);
+  s += "set -euo pipefail\n";
+  s += "runs=(" + runs + ")\n";
+  s += "run=${runs[$SLURM_ARRAY_TASK_ID]}\n";
+  s += "cd " + out + "\n";
+  s += "exec " + kf + " --threads \"${SLURM_CPUS_PER_TASK:-0}\" optimize \"scenes/$run.json\" --out \"$run\" --quiet" +
+       (farm.max_evaluations >= 0 ? " --max-evaluations " + std::to_string(farm.max_evaluations) : "") + "\n";
+  plan.optimize_script = s;
+
+  s = "#!/bin/bash\n";
+  s += "# keyframe farm optimize: gather the runs' report.json into " + farm.out.string() + "/sweep.csv and sweep.png\n";
+  s += "#SBATCH --job-name=keyframe-gather-" + name + "\n";
+  s += "#SBATCH --output=" + logs + "/gather-%j.out\n";
+  s += slurm::sbatch_lines(farm.slurm);
+  s += "set -euo pipefail\n";
+  s += "exec " + kf + " farm gather " + out + "\n";
+  plan.gather_script = s;
+  return plan;
+}
+
+std::vector<std::string> gather_sweep(const fs::path& out) {
+  const fs::path manifest_file = out / "sweep.json";
+  std::error_code ec;
+  if (!fs::is_regular_file(manifest_file, ec))
+    throw InputError(out.string() + ": not a sweep directory (no sweep.json; made by keyframe farm optimize)");
+  const json m = json::parse(read_all(manifest_file), nullptr, false);
+  if (!m.is_object() || !m.contains("runs") || !m["runs"].is_array() || !m.contains("keys"))
+    throw InputError(manifest_file.string() + ": not a sweep manifest");
+  const auto keys = m["keys"].get<std::vector<std::string>>();
+
+  // Scalar numbers of each report's measures and final terms become columns, in the order first met.
+  const char* fixed[] = {"evaluations", "wall_seconds", "initial_objective", "final_objective"};
+  std::vector<std::string> extra;
+  std::set<std::string> seen;
+  std::vector<json> reports;
+  std::vector<std::string> unfinished;
+  for (const auto& run : m["runs"]) {
+    const fs::path dir = out / run.value("name", "");
+    json flat;
+    if (run_finished(dir)) {
+      flat = json::parse(read_all(dir / "report.json")).flatten();
+      for (const auto& [k, v] : flat.items())
+        if (v.is_number() && (k.rfind("/measures/", 0) == 0 || k.rfind("/final_terms/", 0) == 0) && seen.insert(k).second)
+          extra.push_back(k);
+    } else {
+      unfinished.push_back(run.value("name", ""));
+    }
+    reports.push_back(flat);
+  }
+  std::ostringstream csv;
+  csv << std::setprecision(10) << "run,scene";
+  for (const auto& k : keys) csv << "," << plain(k, "/._-");
+  for (const char* f : fixed) csv << "," << f;
+  for (const auto& k : extra) csv << "," << plain(k.substr(1), "/._-");
+  csv << ",status\n";
+  for (size_t i = 0; i < reports.size(); ++i) {
+    const json& run = m["runs"][i];
+    const json& r = reports[i];
+    csv << cell(run.value("name", "")) << "," << cell(run.value("scene", ""));
+    for (const auto& k : keys) csv << "," << (run["values"].contains(k) ? cell(run["values"][k]) : "");
+    for (const char* f : fixed) csv << "," << (r.contains("/" + std::string(f)) ? cell(r["/" + std::string(f)]) : "");
+    for (const auto& k : extra) csv << "," << (r.contains(k) ? cell(r[k]) : "");
+    csv << "," << (r.is_null() ? "not finished" : cell(r.value("/status", json("finished")))) << "\n";
+  }
+  write_file_atomic(out / "sweep.csv", csv.str());
+
+  // One numeric sweep over one scene: final objective against the value; otherwise a bar per run.
+  const int final_col = 2 + int(keys.size()) + 4;
+  bool numeric = keys.size() == 1;
+  std::set<std::string> scenes;
+  for (const auto& run : m["runs"]) {
+    scenes.insert(run.value("scene", ""));
+    if (numeric && !(run["values"].contains(keys[0]) && run["values"][keys[0]].is_number())) numeric = false;
+  }
+  const std::string title = out.filename().string() + ": final objective";
+  if (numeric && scenes.size() == 1)
+    plot_csv(out / "sweep.csv", out / "sweep.png", title, 3, {final_col}, true);
+  else
+    bar_plot_csv(out / "sweep.csv", out / "sweep.png", title, {1}, {final_col}, true);
+  return unfinished;
+}
+
+}  // namespace kf::farm
