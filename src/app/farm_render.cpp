@@ -100,8 +100,9 @@ RenderPlan plan_render_farm(const RenderFarm& farm) {
   s += "#SBATCH --output=" + logs + "/render-%A_%a.out\n";
   s += slurm::sbatch_lines(farm.slurm);
   s += "set -euo pipefail\n";
+  s += "keyframe=" + kf + "\nrun=" + dir + "\n";
   s += "chunks=(" + chunks + ")\n";
-  s += "exec " + kf + " --threads \"${SLURM_CPUS_PER_TASK:-0}\" render " + dir;
+  s += "exec \"$keyframe\" --threads \"${SLURM_CPUS_PER_TASK:-0}\" render \"$run\"";
   if (plan.turntable)
     s += " --frames " + std::to_string(r.frame_begin) + " --turntable " + std::to_string(r.turntable) +
          " --views \"${chunks[$SLURM_ARRAY_TASK_ID]}\" \\\n  ";
@@ -121,12 +122,13 @@ RenderPlan plan_render_farm(const RenderFarm& farm) {
   s += "#SBATCH --kill-on-invalid-dep=yes\n";
   s += slurm::sbatch_lines(farm.slurm);
   s += "set -euo pipefail\n";
-  s += kf + " farm check " + dir +
+  s += "keyframe=" + kf + "\nrun=" + dir + "\n";
+  s += "\"$keyframe\" farm check \"$run\"" +
        (plan.turntable ? " --turntable " + std::to_string(r.turntable)
                        : " --frames " + range_text(plan.first, plan.last)) +
        " --size " + size + "\n";
-  s += "if command -v ffmpeg >/dev/null; then " + kf + " clip " + dir + (plan.turntable ? " --turntable" : "") +
-       "; else echo \"no ffmpeg on $(hostname): no clip\"; fi\n";
+  s += "if command -v ffmpeg >/dev/null; then\n  \"$keyframe\" clip \"$run\"" +
+       std::string(plan.turntable ? " --turntable" : "") + "\nelse\n  echo \"no ffmpeg on $(hostname): no clip\"\nfi\n";
   plan.check_script = s;
   return plan;
 }

@@ -193,10 +193,11 @@ SweepPlan plan_sweep_farm(const SweepFarm& farm) {
   s += "#SBATCH --output=" + logs + "/optimize-%A_%a.out\n";
   s += slurm::sbatch_lines(farm.slurm);
   s += "set -euo pipefail\n";
+  s += "keyframe=" + kf + "\n";
   s += "runs=(" + runs + ")\n";
   s += "run=${runs[$SLURM_ARRAY_TASK_ID]}\n";
   s += "cd " + out + "\n";
-  s += "exec " + kf + " --threads \"${SLURM_CPUS_PER_TASK:-0}\" optimize \"scenes/$run.json\" --out \"$run\" --quiet" +
+  s += "exec \"$keyframe\" --threads \"${SLURM_CPUS_PER_TASK:-0}\" optimize \"scenes/$run.json\" --out \"$run\" --quiet" +
        (farm.max_evaluations >= 0 ? " --max-evaluations " + std::to_string(farm.max_evaluations) : "") + "\n";
   plan.optimize_script = s;
 
