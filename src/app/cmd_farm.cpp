@@ -1,4 +1,6 @@
 // keyframe farm: render farms and optimisation sweeps as Slurm job arrays.
+#include <unistd.h>
+
 #include <iostream>
 
 #include "app/cli_ranges.h"
@@ -36,7 +38,12 @@ void add_submission_options(CLI::App* sub, Submission& s) {
 }
 
 fs::path keyframe_program(const Submission& s) {
-  if (!s.keyframe.empty()) return fs::absolute(s.keyframe);
+  if (!s.keyframe.empty()) {
+    // On a shared filesystem the program the nodes run is visible here too (a dry run may name any path).
+    if (!s.dry_run && access(s.keyframe.c_str(), X_OK) != 0)
+      throw InputError("--keyframe " + s.keyframe + ": not an executable program");
+    return fs::absolute(s.keyframe);
+  }
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
   if (ec) throw InputError("cannot tell where keyframe itself is (" + ec.message() + "); pass --keyframe PATH");

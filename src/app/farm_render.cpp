@@ -90,7 +90,10 @@ RenderPlan plan_render_farm(const RenderFarm& farm) {
 
   // The array: task i renders chunks[i].
   std::string chunks;
-  for (const auto& c : plan.chunks) chunks += (chunks.empty() ? "" : " ") + range_text(c.first, c.last);
+  for (const auto& c : plan.chunks) {
+    if (!chunks.empty()) chunks += ' ';
+    chunks += range_text(c.first, c.last);
+  }
   std::string s = "#!/bin/bash\n";
   s += "# keyframe farm render: " + what + " " + std::to_string(plan.first) + ".." + std::to_string(plan.last - 1) +
        " of " + r.run_dir.string() + ", " + std::to_string(todo.size()) + " to render in " +

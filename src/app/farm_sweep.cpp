@@ -53,7 +53,8 @@ std::string cell(const json& j) {
 
 Sweep parse_sweep(const std::string& text) {
   const auto bad = [&](const std::string& why) {
-    return InputError("--sweep " + text + ": " + why + " (expected KEY=V1,V2,... with KEY a JSON pointer into the scene, "
+    return InputError("--sweep " + text + ": " + why +
+                      " (expected KEY=V1,V2,... with KEY a JSON pointer into the scene, "
                       "e.g. /cloth/stretch=500,2000)");
   };
   const size_t eq = text.find('=');
@@ -110,8 +111,9 @@ std::vector<SweepRun> plan_sweep(const std::vector<fs::path>& scenes, const std:
     const json j = json::parse(read_all(file));
     for (const auto& s : sweeps) {
       const json::json_pointer ptr(s.key);
-      if (!j.contains(ptr.parent_pointer()) || !(j[ptr.parent_pointer()].is_object() || j[ptr.parent_pointer()].is_array()))
-        throw InputError("--sweep " + s.key + ": " + file.string() + " has no " + ptr.parent_pointer().to_string() +
+      const auto parent = ptr.parent_pointer();
+      if (!j.contains(parent) || !(j[parent].is_object() || j[parent].is_array()))
+        throw InputError("--sweep " + s.key + ": " + file.string() + " has no " + parent.to_string() +
                          " block to set " + ptr.back() + " in");
       if (j.contains(ptr))
         for (size_t k = 0; k < s.values.size(); ++k)
@@ -197,12 +199,14 @@ SweepPlan plan_sweep_farm(const SweepFarm& farm) {
   s += "runs=(" + runs + ")\n";
   s += "run=${runs[$SLURM_ARRAY_TASK_ID]}\n";
   s += "cd " + out + "\n";
-  s += "exec \"$keyframe\" --threads \"${SLURM_CPUS_PER_TASK:-0}\" optimize \"scenes/$run.json\" --out \"$run\" --quiet" +
+  s += "exec \"$keyframe\" --threads \"${SLURM_CPUS_PER_TASK:-0}\" optimize \"scenes/$run.json\" --out \"$run\" "
+       "--quiet" +
        (farm.max_evaluations >= 0 ? " --max-evaluations " + std::to_string(farm.max_evaluations) : "") + "\n";
   plan.optimize_script = s;
 
   s = "#!/bin/bash\n";
-  s += "# keyframe farm optimize: gather the runs' report.json into " + farm.out.string() + "/sweep.csv and sweep.png\n";
+  s += "# keyframe farm optimize: gather the runs' report.json into " + farm.out.string() +
+       "/sweep.csv and sweep.png\n";
   s += "#SBATCH --job-name=keyframe-gather-" + name + "\n";
   s += "#SBATCH --output=" + logs + "/gather-%j.out\n";
   s += slurm::sbatch_lines(farm.slurm);
@@ -234,7 +238,8 @@ std::vector<std::string> gather_sweep(const fs::path& out) {
     if (run_finished(dir)) {
       flat = json::parse(read_all(dir / "report.json")).flatten();
       for (const auto& [k, v] : flat.items())
-        if (v.is_number() && (k.rfind("/measures/", 0) == 0 || k.rfind("/final_terms/", 0) == 0) && seen.insert(k).second)
+        if (v.is_number() && (k.rfind("/measures/", 0) == 0 || k.rfind("/final_terms/", 0) == 0) &&
+            seen.insert(k).second)
           extra.push_back(k);
     } else {
       unfinished.push_back(run.value("name", ""));
@@ -252,7 +257,7 @@ std::vector<std::string> gather_sweep(const fs::path& out) {
     const json& r = reports[i];
     csv << cell(run.value("name", "")) << "," << cell(run.value("scene", ""));
     for (const auto& k : keys) csv << "," << (run["values"].contains(k) ? cell(run["values"][k]) : "");
-    for (const char* f : fixed) csv << "," << (r.contains("/" + std::string(f)) ? cell(r["/" + std::string(f)]) : "");
+    for (const char* f : fixed) csv << "," << (r.contains(std::string("/") + f) ? cell(r[std::string("/") + f]) : "");
     for (const auto& k : extra) csv << "," << (r.contains(k) ? cell(r[k]) : "");
     csv << "," << (r.is_null() ? "not finished" : cell(r.value("/status", json("finished")))) << "\n";
   }

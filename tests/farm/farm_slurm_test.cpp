@@ -59,7 +59,7 @@ TEST_F(FarmSlurm, RenderInThreeChunksAndSweepOnALocalCluster) {
 
   std::unique_ptr<LocalSlurm> slurm;
   try {
-    slurm = std::make_unique<LocalSlurm>(dir_ / "slurm");
+    slurm = std::make_unique<LocalSlurm>();
   } catch (const std::exception& e) {
     FAIL() << e.what();
   }

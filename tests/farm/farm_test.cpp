@@ -18,7 +18,8 @@ class Farm : public TempDirTest {
     fs::create_directories(dir_ / "bin");
     write("bin/sbatch", "#!/bin/sh\necho \"$*\" >> \"" + (dir_ / "sbatch.log").string() + "\"\n"
                         "n=$(wc -l < \"" + (dir_ / "sbatch.log").string() + "\")\n"
-                        "if [ \"$n\" = \"${FAIL_AT:-0}\" ]; then echo 'sbatch: error: invalid account' >&2; exit 1; fi\n"
+                        "if [ \"$n\" = \"${FAIL_AT:-0}\" ]; then\n"
+                        "  echo 'sbatch: error: invalid account' >&2; exit 1\nfi\n"
                         "echo $((100 + n))\n");
     write("bin/scancel", "#!/bin/sh\necho \"$*\" >> \"" + (dir_ / "scancel.log").string() + "\"\n");
     fs::permissions(dir_ / "bin/sbatch", fs::perms::owner_all);
@@ -64,12 +65,14 @@ TEST_F(Farm, DryRunPrintsShortScriptsAndWritesNothing) {
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(list_tree(dir_), before) << "a dry run writes nothing";
   EXPECT_TRUE(sbatch_calls().empty()) << "a dry run submits nothing";
-  for (const std::string& line : std::vector<std::string>{"#SBATCH --job-name=keyframe-render-run\n", "#SBATCH --array=0-2\n", "#SBATCH --partition=gpu\n",
-        "#SBATCH --time=1:00:00\n", "#SBATCH --qos=high\n", "chunks=(0:5 5:10 10:12)\n",
-        "run=" + (dir_ / "run").string() + "\n", "render \"$run\" --frames \"${chunks[$SLURM_ARRAY_TASK_ID]}\"",
-        "--backend embree --size 64x48 --spp 4\n", "#SBATCH --job-name=keyframe-check-run\n",
-        "\"$keyframe\" farm check \"$run\" --frames 0:12 --size 64x48\n",
-        "# sbatch --dependency=afterok:JOBID " + (dir_ / "run/farm/check.sbatch").string() + "\n"})
+  const std::vector<std::string> expected = {
+      "#SBATCH --job-name=keyframe-render-run\n", "#SBATCH --array=0-2\n", "#SBATCH --partition=gpu\n",
+      "#SBATCH --time=1:00:00\n", "#SBATCH --qos=high\n", "chunks=(0:5 5:10 10:12)\n",
+      "run=" + (dir_ / "run").string() + "\n", "render \"$run\" --frames \"${chunks[$SLURM_ARRAY_TASK_ID]}\"",
+      "--backend embree --size 64x48 --spp 4\n", "#SBATCH --job-name=keyframe-check-run\n",
+      "\"$keyframe\" farm check \"$run\" --frames 0:12 --size 64x48\n",
+      "# sbatch --dependency=afterok:JOBID " + (dir_ / "run/farm/check.sbatch").string() + "\n"};
+  for (const auto& line : expected)
     EXPECT_NE(r.output.find(line), std::string::npos) << "missing: " << line << "\n" << r.output;
   EXPECT_LE(count_lines(r.output), 40) << r.output;  // two scripts of under 20 lines and how to submit them
 }

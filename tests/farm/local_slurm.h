@@ -10,6 +10,7 @@
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <fcntl.h>
+#include <stdlib.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -31,10 +32,16 @@ namespace fs = std::filesystem;
 
 class LocalSlurm {
  public:
-  // Starts the cluster in `dir` (created) and waits until its node is idle. Throws std::runtime_error with
+  // Starts the cluster in a new private directory and waits until its node is idle. Throws std::runtime_error with
   // what went wrong (and the end of the daemon's log) within about `timeout_s` seconds; whatever was
   // started by then is stopped again.
-  explicit LocalSlurm(const fs::path& dir, int timeout_s = 40) : dir_(dir) {
+  explicit LocalSlurm(int timeout_s = 40) {
+    // A short private directory: munged's socket path must fit in a sockaddr_un (108 bytes).
+    fs::path base = fs::temp_directory_path();
+    if (base.string().size() > 60) base = "/tmp";
+    std::string templ = (base / "kf-slurm-XXXXXX").string();
+    if (!mkdtemp(templ.data())) throw std::runtime_error("local Slurm: cannot create a directory in " + base.string());
+    dir_ = templ;
     try {
       start(timeout_s);
     } catch (...) {
@@ -42,7 +49,13 @@ class LocalSlurm {
       throw;
     }
   }
-  ~LocalSlurm() { stop(); }
+  // Stops the cluster; its directory (configuration, logs) is kept only when the test failed.
+  ~LocalSlurm() {
+    stop();
+    std::error_code ec;
+    if (!::testing::Test::HasFailure()) fs::remove_all(dir_, ec);
+  }
+  const fs::path& dir() const { return dir_; }
   LocalSlurm(const LocalSlurm&) = delete;
   LocalSlurm& operator=(const LocalSlurm&) = delete;
 
@@ -134,8 +147,10 @@ class LocalSlurm {
     int status = 0;
     if (waitpid(pid, &status, WNOHANG) == pid) {
       pids_.erase(std::find(pids_.begin(), pids_.end(), pid));
-      throw std::runtime_error("local Slurm: " + name + " exited at start (status " + std::to_string(status) +
-                               "); end of " + (dir_ / log).string() + ":\n" + log_tail(log));
+      const std::string how = WIFEXITED(status) ? "exit code " + std::to_string(WEXITSTATUS(status))
+                                                : "signal " + std::to_string(WTERMSIG(status));
+      throw std::runtime_error("local Slurm: " + name + " stopped at start (" + how + "); end of " +
+                               (dir_ / log).string() + ":\n" + log_tail(log));
     }
   }
 
@@ -157,7 +172,8 @@ class LocalSlurm {
       throw std::runtime_error("local Slurm: must run as root (slurmd starts jobs as their users), as CI does");
     for (const char* p : {"/usr/sbin/munged", "/usr/sbin/slurmctld", "/usr/sbin/slurmd", "/usr/bin/sbatch"})
       if (access(p, X_OK) != 0)
-        throw std::runtime_error(std::string("local Slurm: ") + p + " is missing (scripts/setup installs slurm-wlm and munge)");
+        throw std::runtime_error(std::string("local Slurm: ") + p +
+                                 " is missing (scripts/setup installs slurm-wlm and munge)");
     fs::create_directories(dir_ / "state");
     fs::create_directories(dir_ / "spool");
     fs::permissions(dir_, fs::perms::owner_all | fs::perms::group_exec | fs::perms::others_exec);
