@@ -68,7 +68,7 @@ RenderPlan plan_render_farm(const RenderFarm& farm) {
                      " has frames 0.." + std::to_string(F - 1) + " (A:B renders A..B-1)");
 
   RenderPlan plan;
-  plan.name = r.run_dir.filename().string();
+  plan.name = slurm::job_name(r.run_dir.filename().string());
   plan.turntable = r.turntable > 0;
   plan.first = plan.turntable ? 0 : r.frame_begin;
   plan.last = plan.turntable ? r.turntable : end;

@@ -181,7 +181,7 @@ SweepPlan plan_sweep_farm(const SweepFarm& farm) {
   const std::string kf = slurm::shell_quote(farm.keyframe.string());
   const std::string out = slurm::shell_quote(farm.out.string());
   const std::string logs = slurm::shell_quote((farm.out / "farm" / "logs").string());
-  const std::string name = farm.out.filename().string();
+  const std::string name = slurm::job_name(farm.out.filename().string());
   std::string keys;
   for (const auto& k : farm.keys) keys += (keys.empty() ? "" : ", ") + k;
   std::string runs;

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <regex>
 
@@ -77,6 +78,12 @@ std::string sbatch_lines(const JobOptions& o) {
     if (!value->empty()) s += "#SBATCH --" + std::string(name) + "=" + *value + "\n";
   for (const auto& e : o.extra) s += "#SBATCH " + e + "\n";
   return s;
+}
+
+std::string job_name(const std::string& name) {
+  std::string out;
+  for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '_' ? c : '_';
+  return out;
 }
 
 std::string shell_quote(const std::string& word) {

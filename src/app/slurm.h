@@ -18,6 +18,9 @@ void check(const JobOptions& options);
 // One "#SBATCH --option=value\n" line per option given, in a fixed order, the extras last.
 std::string sbatch_lines(const JobOptions& options);
 
+// `name` as a job name: letters, digits, '.', '_', '-' kept, anything else (spaces, quotes) as '_'.
+std::string job_name(const std::string& name);
+
 // A word quoted for bash when it needs to be ('...' with ' written as '\'').
 std::string shell_quote(const std::string& word);
 
