@@ -92,7 +92,7 @@ TEST_F(FarmSlurm, RenderInThreeChunksAndSweepOnALocalCluster) {
   // Every job and array task completed.
   const auto all_render = job_lines(*slurm, render_id);
   ASSERT_EQ(all_render.size(), 3u) << slurm->client("scontrol show job " + render_id).output;
-  for (const std::string id : {render_id, check_id, optimize_id, gather_id})
+  for (const std::string& id : {render_id, check_id, optimize_id, gather_id})
     for (const auto& line : job_lines(*slurm, id))
       EXPECT_NE(line.find("JobState=COMPLETED"), std::string::npos)
           << line << "\nlogs:\n" << LocalSlurm::shell("tail -n 5 '" + (dir_ / "run/farm/logs").string() + "'/* '" +
