@@ -51,7 +51,7 @@ fs::path keyframe_program(const Submission& s) {
 }
 
 // Writes the scripts into `farm_dir` and submits the array, then the follow-up job after it.
-void submit(const Submission& s, const fs::path& farm_dir, const std::string& array_name, const std::string& array,
+void submit(const fs::path& farm_dir, const std::string& array_name, const std::string& array,
             const std::string& after_name, const std::string& after, const std::string& dependency) {
   const fs::path sbatch = slurm::require_sbatch();
   ensure_directory(farm_dir / "logs");
@@ -120,7 +120,7 @@ void add_farm_render(CLI::App* farm) {
     if (opt->dry_run)
       print_dry_run(plan.farm_dir, "render.sbatch", plan.render_script, "check.sbatch", plan.check_script, "afterok");
     else
-      submit(*opt, plan.farm_dir, "render.sbatch", plan.render_script, "check.sbatch", plan.check_script, "afterok");
+      submit(plan.farm_dir, "render.sbatch", plan.render_script, "check.sbatch", plan.check_script, "afterok");
   });
 }
 
@@ -174,7 +174,7 @@ void add_farm_optimize(CLI::App* farm) {
     ensure_directory(f.out / "scenes");
     for (size_t k : plan.todo) write_json(f.out / "scenes" / (f.runs[k].name + ".json"), f.runs[k].file);
     write_json(f.out / "sweep.json", farm::sweep_manifest(f));
-    submit(*opt, farm_dir, "optimize.sbatch", plan.optimize_script, "gather.sbatch", plan.gather_script, "afterany");
+    submit(farm_dir, "optimize.sbatch", plan.optimize_script, "gather.sbatch", plan.gather_script, "afterany");
   });
 }
 

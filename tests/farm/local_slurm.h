@@ -97,18 +97,28 @@ class LocalSlurm {
   }
 
  private:
-  static int free_port() {
-    const int s = socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t len = sizeof a;
-    if (s < 0 || bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 ||
-        getsockname(s, reinterpret_cast<sockaddr*>(&a), &len) != 0)
-      throw std::runtime_error("local Slurm: cannot find a free TCP port");
-    const int port = ntohs(a.sin_port);
-    close(s);
-    return port;
+  // Two ports nobody listens on, below Linux's ephemeral range (32768+) so that client connections made
+  // meanwhile cannot take them; both are held while the second is found.
+  static std::pair<int, int> free_ports() {
+    std::mt19937 pick(std::random_device{}());
+    std::vector<int> held, ports;
+    for (int attempt = 0; attempt < 200 && ports.size() < 2; ++attempt) {
+      const int port = 20000 + int(pick() % 12000);
+      const int s = socket(AF_INET, SOCK_STREAM, 0);
+      sockaddr_in a{};
+      a.sin_family = AF_INET;
+      a.sin_addr.s_addr = htonl(INADDR_ANY);
+      a.sin_port = htons(uint16_t(port));
+      if (s >= 0 && bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0) {
+        held.push_back(s);
+        ports.push_back(port);
+      } else if (s >= 0) {
+        close(s);
+      }
+    }
+    for (int s : held) close(s);
+    if (ports.size() < 2) throw std::runtime_error("local Slurm: cannot find two free TCP ports");
+    return {ports[0], ports[1]};
   }
 
   // Forks `argv` with stdout/stderr into `log`; the child gets SIGTERM if the test process dies.
@@ -191,10 +201,11 @@ class LocalSlurm {
     node = node.substr(0, node.find('.'));
     const std::string d = dir_.string();
     const int nproc = int(std::max(1u, std::thread::hardware_concurrency()));
+    const auto ports = free_ports();
     conf_ = dir_ / "slurm.conf";
     std::ofstream(conf_) << "ClusterName=kftest\n"
                          << "SlurmctldHost=" << node << "(127.0.0.1)\n"
-                         << "SlurmctldPort=" << free_port() << "\nSlurmdPort=" << free_port() << "\n"
+                         << "SlurmctldPort=" << ports.first << "\nSlurmdPort=" << ports.second << "\n"
                          << "SlurmUser=root\nSlurmdUser=root\n"
                          << "AuthType=auth/munge\nCredType=cred/munge\nAuthInfo=socket=" << d << "/munge.socket\n"
                          << "StateSaveLocation=" << d << "/state\nSlurmdSpoolDir=" << d << "/spool\n"
