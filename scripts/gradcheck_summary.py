@@ -15,7 +15,8 @@ for (scene, adjoint), g in groups.items():
     steps = OrderedDict()
     for r in g:
         steps.setdefault(r["dt"], set()).add(r["frames"])
-    h = ", ".join(f"{dt} ({'/'.join(sorted(f))})" for dt, f in steps.items())
+    label = lambda frames: "/".join("all" if n == "0" else n for n in sorted(frames))  # 0: the scene's own
+    h = ", ".join(f"{dt} ({label(f)})" for dt, f in steps.items())
     err = [float(r["max_rel_error"]) for r in g]
     kinks = sum(int(r["kinks"]) for r in g)
     samples = sum(int(r["kinks"]) + int(r["checked"]) for r in g)
