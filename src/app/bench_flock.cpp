@@ -55,8 +55,7 @@ nlohmann::json bench_flock(const FlockSweepOptions& o, const std::filesystem::pa
     const BenchPoint p = measure_point(flock_bench_scene(agents, o.frames), po);
     std::vector<std::string> row = {std::to_string(agents)};
     for (auto& c : bench_point_row(p)) row.push_back(c);
-    const double per_eval = p.evaluations ? p.optimize_s / p.evaluations : 0;
-    row.push_back(fmt(per_eval));
+    row.push_back(p.evaluations ? fmt(p.optimize_s / p.evaluations) : "");
     t.add(row);
     n.push_back(agents);
     tg.push_back(p.gradient_s);

@@ -48,6 +48,7 @@ BenchPoint measure_point(const Scene& scene, const BenchPointOptions& o) {
   p.keyframe_initial = keyframe_terms(problem);
   if (o.gradcheck_samples > 0 && !p.diverged) {
     const GradcheckResult c = gradcheck(problem, z0, {.samples = o.gradcheck_samples, .eps = o.gradcheck_eps});
+    p.gradchecked = true;
     p.grad_cosine = c.cosine;
     p.grad_rel_error = c.rel_error_norm;
   }
@@ -100,7 +101,8 @@ std::vector<std::string> bench_point_columns() {
 
 std::vector<std::string> bench_point_row(const BenchPoint& p) {
   return {std::to_string(p.steps),  std::to_string(p.control_variables), fmt(p.forward_s),
-          fmt(p.gradient_s),        fmt(p.grad_cosine),                  fmt(p.grad_rel_error),
+          fmt(p.gradient_s),        p.gradchecked ? fmt(p.grad_cosine) : "",
+          p.gradchecked ? fmt(p.grad_rel_error) : "",
           fmt(p.keyframe_initial),  fmt(p.keyframe_final),               fmt(p.optimize_s),
           std::to_string(p.evaluations), p.diverged ? "1" : "0"};
 }

@@ -22,6 +22,7 @@ struct BenchPoint {
   int steps = 0, control_variables = 0;
   double forward_s = 0;             // one forward simulation (s, wall clock)
   double gradient_s = 0;            // one forward + adjoint pass (s)
+  bool gradchecked = false;         // the two below were measured (the CSV leaves them empty otherwise)
   double grad_cosine = 0;           // adjoint vs central differences on the sample (1 = same direction)
   double grad_rel_error = 0;        // ‖adjoint − fd‖ / ‖fd‖ on the sample
   double keyframe_initial = 0;      // keyframe terms of φ (no effort) at the initial guess

@@ -1,6 +1,7 @@
 #include "scene/character_spec.h"
 
 #include <algorithm>
+#include <fstream>
 
 #include "core/error.h"
 #include "core/trajectory.h"
@@ -22,6 +23,14 @@ double animation_time(const CharacterSpec& spec, double frame) {
 
 namespace {
 
+CapeAnchors parse_cape_anchors(Block& b) {
+  CapeAnchors a;
+  a.mesh = b.string("mesh", "");
+  a.points = b.points3("points", 2, -100.0, 100.0);
+  b.finish();
+  return a;
+}
+
 // One frame of a run's trajectory, checked against the cape's particle count.
 void load_run_state(Block& b, const std::filesystem::path& run, int frame, int particles, VecX& x, VecX& v) {
   const Trajectory t = load_trajectory(run / "trajectory.bin");
@@ -34,6 +43,24 @@ void load_run_state(Block& b, const std::filesystem::path& run, int frame, int p
 }
 
 }  // namespace
+
+std::filesystem::path cape_anchors_file(const std::filesystem::path& mesh_file) {
+  std::filesystem::path p = mesh_file;
+  return p.replace_extension(".cape.json");
+}
+
+CapeAnchors load_cape_anchors(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string() + ": cannot open the cape anchors file");
+  Json j;
+  try {
+    j = Json::parse(in);
+  } catch (const Json::exception& e) {
+    throw InputError(file.string() + ": not valid JSON (" + e.what() + ")");
+  }
+  Block b(j, file.string());
+  return parse_cape_anchors(b);
+}
 
 CharacterSpec parse_character_spec(Block b, Scene& scene) {
   if (!scene.cloth) b.fail_here("expected a \"cloth\" block for the cape (a character needs a cloth)");
@@ -48,6 +75,15 @@ CharacterSpec parse_character_spec(Block b, Scene& scene) {
         b.fail_rel("/time/" + std::to_string(i), "expected frames in ascending order");
   }
   c.offset = b.vec3("offset", Vec3::Zero());
+  if (auto anchors = b.optional_child("anchors")) {
+    c.anchors = parse_cape_anchors(*anchors);
+  } else {
+    const auto file = cape_anchors_file(c.file);
+    if (!std::filesystem::exists(file))
+      b.fail("anchors", "expected an \"anchors\" block {\"mesh\", \"points\"}, or the file " + file.string() +
+                            " beside the mesh");
+    c.anchors = load_cape_anchors(file);
+  }
   {
     Block body = b.child("body");
     c.body_thickness = body.number("thickness", c.body_thickness, 1e-5, 1.0);

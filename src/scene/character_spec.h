@@ -9,6 +9,9 @@
 //     "time": [[0, 0.3], [30, 1.9]],   // (frame, animation seconds) keys, frames ascending; piecewise
 //                                      // linear between keys, held before the first and after the last
 //     "offset": [0, 0, 0],             // world-from-file translation, metres
+//     "anchors": {"mesh": "Torso", "points": [[-0.18, 0.47, -0.22], ...]},
+//                                      // where the cape's top edge hangs (below); default: the file
+//                                      // beside the mesh named like it with ".cape.json"
 //     "body": {"thickness": 0.012, "stiffness": 2000, "search": 0.06},
 //     "self": {"enabled": true, "thickness": 0.01, "stiffness": 500},
 //     "start": {"run": "../out/cape-a", "frame": 39},             // initial cape state (x and v)
@@ -18,6 +21,8 @@
 // The cloth block describes the cape; its top edge is pinned to the shoulder anchors whatever "pins" says.
 #include <filesystem>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "core/types.h"
 
@@ -25,11 +30,25 @@ namespace kf {
 class Block;
 struct Scene;
 
+// Where a cape hangs from a character: points in the mesh file's frame (metres), ordered along the cape's
+// top edge, each followed by the nearest bind-pose vertex of mesh `mesh` ("" = every mesh). It belongs to the
+// character asset, so it is read from a file beside the mesh unless the scene states it.
+struct CapeAnchors {
+  std::string mesh;
+  std::vector<Vec3> points;
+};
+
+// The anchors file beside a character mesh: "body.X" -> "body.cape.json".
+std::filesystem::path cape_anchors_file(const std::filesystem::path& mesh_file);
+// Reads {"mesh": ..., "points": [[x, y, z], ...]} (at least 2 points). Throws InputError naming the file.
+CapeAnchors load_cape_anchors(const std::filesystem::path& file);
+
 struct CharacterSpec {
   std::filesystem::path file;        // resolved against the scene's directory
   int animation = 0;
   std::vector<Vec2> time_keys{{0.0, 0.0}};  // (frame, seconds)
   Vec3 offset = Vec3::Zero();        // metres
+  CapeAnchors anchors;
   double body_thickness = 0.012;     // m: contact springs act within this distance of the body
   double body_stiffness = 2000.0;    // N/m
   double body_search = 0.06;         // m: particles deeper than this inside the body get no force

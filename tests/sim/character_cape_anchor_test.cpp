@@ -2,18 +2,23 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <filesystem>
 
 #include "core/error.h"
+#include "scene/scene.h"
 #include "sim/character/cape_anchors.h"
 #include "character_test_util.h"
 
 namespace kf {
 namespace {
 
+// The anchors shipped beside the character mesh.
+CapeAnchors shipped_anchors() { return load_cape_anchors(cape_anchors_file(test::character_asset())); }
+
 TEST(CapeAnchors, NearTheirTargetsOnTheTorsoBack) {
   Character c(test::character_asset());
-  const std::vector<int> anchors = cape_anchor_vertices(c);
-  const std::vector<Vec3> targets = cape_anchor_targets();
+  const std::vector<Vec3> targets = shipped_anchors().points;
+  const std::vector<int> anchors = cape_anchor_vertices(c, shipped_anchors());
   ASSERT_EQ(anchors.size(), targets.size());
   for (size_t i = 0; i < anchors.size(); ++i) {
     EXPECT_GE(anchors[i], c.mesh_vertex_begin()[0]);
@@ -31,7 +36,7 @@ TEST(CapeAnchors, NearTheirTargetsOnTheTorsoBack) {
 
 TEST(CapeAnchors, FollowTheBodyUpInTheJump) {
   Character c(test::character_asset());
-  const std::vector<int> anchors = cape_anchor_vertices(c);
+  const std::vector<int> anchors = cape_anchor_vertices(c, shipped_anchors());
   VecX x0, x1, a0, a1;
   c.pose(0.0, x0);
   c.pose(1.7, x1);  // the top of the jump: the pelvis is 0.41 m higher
@@ -46,7 +51,39 @@ TEST(CapeAnchors, FollowTheBodyUpInTheJump) {
 
 TEST(CapeAnchors, UnknownMeshIsAnInputError) {
   Character c(test::character_asset());
-  EXPECT_THROW(nearest_bind_vertices(c, cape_anchor_targets(), "Cape"), InputError);
+  EXPECT_THROW(nearest_bind_vertices(c, shipped_anchors().points, "Cape"), InputError);
+}
+
+// The anchors are data: the file beside the mesh by default, the scene's "anchors" block when given, and a
+// clear error naming the key when neither exists.
+TEST(CapeAnchors, ReadFromTheSceneOrTheFileBesideTheMesh) {
+  test::TempDir tmp;
+  std::filesystem::copy_file(cape_anchors_file(test::character_asset()), tmp.path() / "body.cape.json");
+  const auto scene_with = [&](const std::string& character) {
+    return R"({"time": {"fps": 30, "frames": 2}, "cloth": {"nx": 4, "ny": 4}, "character": )" + character + "}";
+  };
+  const Scene beside = parse_scene(scene_with(R"({"file": "body.X"})"), tmp.path() / "a.json");
+  EXPECT_EQ(beside.character->anchors.mesh, "Torso");
+  ASSERT_EQ(beside.character->anchors.points.size(), 5u);
+  EXPECT_EQ(beside.character->anchors.points[2], Vec3(0.0, 0.50, -0.24));
+
+  const Scene stated = parse_scene(
+      scene_with(R"({"file": "body.X", "anchors": {"points": [[-0.1, 0.4, -0.2], [0.1, 0.4, -0.2]]}})"),
+      tmp.path() / "b.json");
+  EXPECT_EQ(stated.character->anchors.mesh, "");
+  ASSERT_EQ(stated.character->anchors.points.size(), 2u);
+  EXPECT_EQ(stated.character->anchors.points[1], Vec3(0.1, 0.4, -0.2));
+
+  try {
+    parse_scene(scene_with(R"({"file": "other.X"})"), tmp.path() / "c.json");
+    FAIL() << "no anchors file and no anchors block";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/character/anchors: expected"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("other.cape.json"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(parse_scene(scene_with(R"({"file": "body.X", "anchors": {"points": [[0, 0, 0]]}})"),
+                           tmp.path() / "d.json"),
+               InputError);  // one point cannot span an edge
 }
 
 }  // namespace

@@ -35,7 +35,7 @@ CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, d
   for (int k = 0; k < int(c.pins.size()); ++k) params.push_back(c.nx > 1 ? double(k) / (c.nx - 1) : 0.5);
 
   // The pins' path over the whole run (one pose per step, plus one past the end for the last velocity).
-  const std::vector<int> anchor_ids = cape_anchor_vertices(character_);
+  const std::vector<int> anchor_ids = cape_anchor_vertices(character_, character.anchors);
   std::vector<std::vector<Vec3>> anchors;
   VecX gathered;
   for (int n = 0; n <= steps + 1; ++n) {
@@ -119,7 +119,7 @@ bool CapeSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& 
   if (n >= int(body_count_.size())) {  // a run longer than the one the system was built for
     body_count_.resize(n + 1, 0);
     self_count_.resize(n + 1, 0);
-    min_distance_.resize(n + 1, 0.0);
+    min_distance_.resize(n + 1, std::numeric_limits<double>::infinity());
   }
   body_count_[n] = nb;
   min_distance_[n] = phi_min;
@@ -151,11 +151,12 @@ std::vector<std::pair<std::string, double>> CapeSystem::run_stats() const {
     max_self = std::max(max_self, double(self_count_[n]));
     contact_steps += (body_count_[n] + self_count_[n]) > 0;
   }
-  return {{"body_contacts", body},         {"self_contacts", self},
-          {"max_body_contacts", max_body}, {"max_self_contacts", max_self},
-          {"contact_steps", contact_steps}, {"cape_length", cape_length_},
-          {"min_body_distance",
-           std::isfinite(min_distance) ? min_distance : std::max(spec_.body_thickness, spec_.body_search)}};
+  std::vector<std::pair<std::string, double>> stats = {
+      {"body_contacts", body},         {"self_contacts", self},          {"max_body_contacts", max_body},
+      {"max_self_contacts", max_self}, {"contact_steps", contact_steps}, {"cape_length", cape_length_}};
+  // Only a distance some query measured: without one there is nothing to report.
+  if (std::isfinite(min_distance)) stats.emplace_back("min_body_distance", min_distance);
+  return stats;
 }
 
 std::unique_ptr<System> make_cape_system(const Scene& scene, double h) {

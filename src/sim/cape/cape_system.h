@@ -45,8 +45,9 @@ class CapeSystem final : public System {
   // Contacts of the last forward run: body_contacts (particle-steps), self_contacts (pair-steps),
   // max_body_contacts / max_self_contacts (in one step), contact_steps, cape_length (m),
   // min_body_distance (m: the smallest signed distance of a particle to the body met by the contact
-  // queries in any step; negative is penetration, and a particle farther than the query radius is not seen). Steps of a
-  // diverged run after the divergence keep their earlier counts.
+  // queries in any step; negative is penetration, and a particle farther than the query radius is not seen;
+  // absent when no query found a particle in range). Steps of a diverged run after the divergence keep their
+  // earlier counts.
   std::vector<std::pair<std::string, double>> run_stats() const override;
 
   // Animation time (s) of step n and the posed body (3n vertices) at that step (allocates).

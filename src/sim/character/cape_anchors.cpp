@@ -7,11 +7,6 @@
 
 namespace kf {
 
-std::vector<Vec3> cape_anchor_targets() {
-  return {Vec3(-0.18, 0.47, -0.22), Vec3(-0.09, 0.44, -0.265), Vec3(0.0, 0.50, -0.24), Vec3(0.09, 0.44, -0.265),
-          Vec3(0.18, 0.47, -0.22)};
-}
-
 std::vector<int> nearest_bind_vertices(const Character& character, const std::vector<Vec3>& targets,
                                        const std::string& mesh) {
   int begin = 0, end = character.vertex_count();
@@ -38,8 +33,8 @@ std::vector<int> nearest_bind_vertices(const Character& character, const std::ve
   return nearest;
 }
 
-std::vector<int> cape_anchor_vertices(const Character& character) {
-  return nearest_bind_vertices(character, cape_anchor_targets(), "Torso");
+std::vector<int> cape_anchor_vertices(const Character& character, const CapeAnchors& anchors) {
+  return nearest_bind_vertices(character, anchors.points, anchors.mesh);
 }
 
 void gather_vertices(const VecX& x, const std::vector<int>& vertices, VecX& out) {
