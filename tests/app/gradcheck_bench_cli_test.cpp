@@ -1,0 +1,101 @@
+// keyframe gradcheck and keyframe bench from the command line: the JSON and CSV a user reads.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "../reliability/cli_harness.h"
+#include "core/error.h"
+
+namespace kf {
+namespace {
+
+namespace fs = std::filesystem;
+using reliability::run_keyframe;
+
+class GradcheckBenchCli : public reliability::TempDirTest {};
+
+// stdout alone (progress goes to stderr), so it must parse as one JSON object.
+nlohmann::json stdout_json(const std::string& args, const fs::path& cwd) {
+  const std::string cmd = "cd '" + cwd.string() + "' && '" KEYFRAME_BINARY "' " + args + " 2>/dev/null";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  EXPECT_EQ(pclose(p), 0) << args;
+  return nlohmann::json::parse(out);
+}
+
+TEST_F(GradcheckBenchCli, GradcheckPrintsOneJsonObjectWithTheChecksNumbers) {
+  const std::string scenes = KEYFRAME_SOURCE_DIR "/scenes/";
+  const auto cloth =
+      stdout_json("gradcheck " + scenes + "cloth-gradcheck.json --frames 3 --samples 6 --perturb 0.01", dir_);
+  SCOPED_TRACE(cloth.dump());
+  for (const char* key : {"scene", "adjoint", "solver", "checked", "kinks", "max_rel_error", "cosine",
+                          "rel_error_norm", "fd_spread", "phi_noise", "grad_norm", "steps", "control_variables"})
+    EXPECT_TRUE(cloth.contains(key)) << key;
+  EXPECT_EQ(cloth["scene"], "cloth-gradcheck");
+  EXPECT_EQ(cloth["adjoint"], "exact");
+  EXPECT_EQ(cloth["solver"], "direct");
+  EXPECT_EQ(cloth["checked"], 6);
+  EXPECT_EQ(cloth["kinks"], 0);
+  EXPECT_EQ(cloth["steps"], 6);  // 3 frames of the scene's 2 steps each
+  EXPECT_GT(cloth["grad_norm"].get<double>(), 0);
+  EXPECT_LE(cloth["max_rel_error"].get<double>(), 1e-6);
+  EXPECT_GT(cloth["cosine"].get<double>(), 1 - 1e-9);
+
+  // The swap adjoint is the paper's approximation: at perturbed controls it reads visibly worse.
+  const auto swap = stdout_json(
+      "gradcheck " + scenes + "cloth-gradcheck.json --frames 3 --samples 6 --perturb 0.1 --adjoint swap", dir_);
+  EXPECT_EQ(swap["adjoint"], "swap");
+  EXPECT_GT(swap["max_rel_error"].get<double>(), 1e-4) << swap.dump();
+
+  const auto flock = stdout_json("gradcheck " + scenes + "square.json --frames 4 --samples 6 --perturb 0.01", dir_);
+  EXPECT_EQ(flock["checked"], 6) << flock.dump();
+  EXPECT_LE(flock["max_rel_error"].get<double>(), 1e-5) << flock.dump();
+
+  const auto bad = run_keyframe("gradcheck " + scenes + "square.json --dt 0.03", dir_);
+  EXPECT_NE(bad.code, kExitOk);
+  EXPECT_NE(bad.output.find("--dt"), std::string::npos) << bad.output;
+}
+
+TEST_F(GradcheckBenchCli, TinyFlockBenchWritesItsCsvPlotAndSummary) {
+  const auto r =
+      run_keyframe("bench --only flock --agents 20,40 --flock-frames 5 --flock-evaluations 3 --out b", dir_);
+  ASSERT_EQ(r.code, kExitOk) << r.output;
+  std::ifstream csv(dir_ / "b/flock_agents.csv");
+  std::string header, line;
+  std::getline(csv, header);
+  EXPECT_EQ(header.rfind("agents,steps,control_variables,forward_s,gradient_s,grad_cosine,grad_rel_error,", 0), 0u)
+      << header;
+  std::vector<std::vector<std::string>> rows;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    rows.push_back(cells);
+  }
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0][0], "20");
+  EXPECT_EQ(rows[1][0], "40");
+  EXPECT_EQ(std::stoi(rows[1][2]), 2 * std::stoi(rows[0][2]));  // controls grow with the agents
+  for (const auto& row : rows) {
+    EXPECT_GT(std::stod(row[3]), 0);  // forward seconds
+    EXPECT_GT(std::stod(row[4]), 0);  // gradient seconds
+    EXPECT_EQ(row[5], "");            // no finite-difference check asked for: left empty, not 0
+    EXPECT_EQ(row[6], "");
+    EXPECT_LT(std::stod(row[8]), std::stod(row[7]));  // the short optimisation lowered the keyframe error
+  }
+  std::ifstream png(dir_ / "b/flock_agents.png", std::ios::binary);
+  char magic[8] = {};
+  png.read(magic, 8);
+  EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+  std::ifstream summary_file(dir_ / "b/summary.json");
+  const auto summary = nlohmann::json::parse(summary_file);
+  EXPECT_TRUE(std::isfinite(summary["flock"]["gradient_exponent"].get<double>())) << summary.dump();
+}
+
+}  // namespace
+}  // namespace kf
