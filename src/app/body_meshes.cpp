@@ -1,17 +1,14 @@
 #include "app/body_meshes.h"
 
 #include "core/mesh_sequence.h"
-#include "sim/character/character.h"
+#include "sim/character/scene_character.h"
 
 namespace kf {
 
 void write_body_meshes(const Scene& scene, int frames, const std::filesystem::path& path) {
   if (!scene.character) return;
   const CharacterSpec& spec = *scene.character;
-  CharacterOptions options;
-  options.animation = spec.animation;
-  options.placement = Affine(Eigen::Translation3d(spec.offset));
-  Character body(spec.file, options);
+  Character body(spec.file, character_options(spec));
   MeshSequence seq;
   seq.fps = scene.time.fps;
   const auto& tris = body.triangles();
@@ -19,7 +16,7 @@ void write_body_meshes(const Scene& scene, int frames, const std::filesystem::pa
   seq.add_mesh("body", body.vertex_count(), std::move(indices));
   std::vector<VecX> x(1);
   for (int f = 0; f < frames; ++f) {
-    body.pose(animation_time(spec, f), x[0]);
+    pose_at_frame(body, spec, f, x[0]);
     seq.add_frame(x);
   }
   save_mesh_sequence(path, seq);

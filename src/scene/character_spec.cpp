@@ -1,6 +1,7 @@
 #include "scene/character_spec.h"
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 
 #include "core/error.h"
@@ -21,7 +22,48 @@ double animation_time(const CharacterSpec& spec, double frame) {
   return k.back().y();
 }
 
+Eigen::Affine3d character_placement(const CharacterSpec& spec, double frame) {
+  Eigen::Affine3d placement(Eigen::Translation3d(spec.offset));
+  const auto& k = spec.root.keys;
+  if (k.empty()) return placement;
+  Vec3 translate = k.front().translate;
+  double angle = k.front().angle;
+  if (frame >= k.back().frame) {
+    translate = k.back().translate, angle = k.back().angle;
+  } else {
+    for (size_t i = 1; i < k.size(); ++i)
+      if (frame > k[i - 1].frame && frame <= k[i].frame) {
+        const double s = (frame - k[i - 1].frame) / (k[i].frame - k[i - 1].frame);
+        translate = k[i - 1].translate + s * (k[i].translate - k[i - 1].translate);
+        angle = k[i - 1].angle + s * (k[i].angle - k[i - 1].angle);
+        break;
+      }
+  }
+  const Vec3& p = spec.root.pivot;
+  return placement * Eigen::Translation3d(translate + p) * Eigen::AngleAxisd(angle * M_PI / 180.0, spec.root.axis) *
+         Eigen::Translation3d(-p);
+}
+
 namespace {
+
+RootMotion parse_root_motion(Block& b) {
+  RootMotion r;
+  r.pivot = b.vec3("pivot", r.pivot);
+  r.axis = b.vec3("axis", r.axis);
+  if (!(r.axis.norm() > 1e-9)) b.fail("axis", "expected a non-zero axis");
+  r.axis.normalize();
+  for (Block& key : b.array("keys", 1)) {
+    RootMotion::Key k;
+    k.frame = key.number("frame", -1e6, 1e6);
+    k.translate = key.vec3("translate", Vec3::Zero());
+    k.angle = key.number("angle", 0.0, -1e5, 1e5);
+    if (!r.keys.empty() && !(k.frame > r.keys.back().frame)) key.fail("frame", "expected frames in ascending order");
+    key.finish();
+    r.keys.push_back(k);
+  }
+  b.finish();
+  return r;
+}
 
 CapeAnchors parse_cape_anchors(Block& b) {
   CapeAnchors a;
@@ -75,6 +117,7 @@ CharacterSpec parse_character_spec(Block b, Scene& scene) {
         b.fail_rel("/time/" + std::to_string(i), "expected frames in ascending order");
   }
   c.offset = b.vec3("offset", Vec3::Zero());
+  if (auto root = b.optional_child("root")) c.root = parse_root_motion(*root);
   if (auto anchors = b.optional_child("anchors")) {
     c.anchors = parse_cape_anchors(*anchors);
   } else {

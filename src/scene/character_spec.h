@@ -9,6 +9,10 @@
 //     "time": [[0, 0.3], [30, 1.9]],   // (frame, animation seconds) keys, frames ascending; piecewise
 //                                      // linear between keys, held before the first and after the last
 //     "offset": [0, 0, 0],             // world-from-file translation, metres
+//     "root": {"pivot": [0, -1.024, 0], "axis": [1, 0, 0],   // a rigid motion on top of the animation:
+//              "keys": [{"frame": 0, "translate": [0, 1.2, 0], "angle": 0}, ...]}  // translation (m) and
+//                                      // rotation (degrees) about the axis through the pivot (file frame),
+//                                      // piecewise linear between keys, held outside them
 //     "anchors": {"mesh": "Torso", "points": [[-0.18, 0.47, -0.22], ...]},
 //                                      // where the cape's top edge hangs (below); default: the file
 //                                      // beside the mesh named like it with ".cape.json"
@@ -23,6 +27,8 @@
 #include <optional>
 #include <string>
 #include <vector>
+
+#include <Eigen/Geometry>
 
 #include "core/types.h"
 
@@ -43,11 +49,25 @@ std::filesystem::path cape_anchors_file(const std::filesystem::path& mesh_file);
 // Reads {"mesh": ..., "points": [[x, y, z], ...]} (at least 2 points). Throws InputError naming the file.
 CapeAnchors load_cape_anchors(const std::filesystem::path& file);
 
+// A keyed rigid motion of the whole character (a fall, a stunt double's drop): at each key, a translation
+// and an angle about `axis` through `pivot` (file frame, before the offset).
+struct RootMotion {
+  Vec3 pivot = Vec3::Zero();
+  Vec3 axis = Vec3::UnitX();  // unit
+  struct Key {
+    double frame = 0;
+    Vec3 translate = Vec3::Zero();
+    double angle = 0;  // degrees
+  };
+  std::vector<Key> keys;  // frames ascending; empty: no motion
+};
+
 struct CharacterSpec {
   std::filesystem::path file;        // resolved against the scene's directory
   int animation = 0;
   std::vector<Vec2> time_keys{{0.0, 0.0}};  // (frame, seconds)
   Vec3 offset = Vec3::Zero();        // metres
+  RootMotion root;
   CapeAnchors anchors;
   double body_thickness = 0.012;     // m: contact springs act within this distance of the body
   double body_stiffness = 2000.0;    // N/m
@@ -66,6 +86,8 @@ struct CharacterSpec {
 
 // Animation time (seconds) at a (fractional) frame of the scene, by the spec's keys.
 double animation_time(const CharacterSpec& spec, double frame);
+// World-from-file transform at a (fractional) frame: the offset after the root motion.
+Eigen::Affine3d character_placement(const CharacterSpec& spec, double frame);
 
 // Reads the "character" block of a scene that already has its cloth and time; loads the start state and
 // appends the end-target objectives to scene.objectives. Throws InputError with the key's JSON pointer.

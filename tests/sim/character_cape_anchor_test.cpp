@@ -1,12 +1,14 @@
 // Cape anchor vertices: where they are in the bind pose and that they follow the body.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
 #include "core/error.h"
 #include "scene/scene.h"
 #include "sim/character/cape_anchors.h"
+#include "sim/character/scene_character.h"
 #include "character_test_util.h"
 
 namespace kf {
@@ -84,6 +86,43 @@ TEST(CapeAnchors, ReadFromTheSceneOrTheFileBesideTheMesh) {
   EXPECT_THROW(parse_scene(scene_with(R"({"file": "body.X", "anchors": {"points": [[0, 0, 0]]}})"),
                            tmp.path() / "d.json"),
                InputError);  // one point cannot span an edge
+}
+
+// A keyed root motion moves the whole posed body rigidly: translation and angle interpolate linearly between
+// keys and hold outside them; the pins (the anchors) move with it.
+TEST(CharacterRootMotion, InterpolatesKeysAndMovesThePosedBodyRigidly) {
+  test::TempDir tmp;
+  std::filesystem::copy_file(cape_anchors_file(test::character_asset()), tmp.path() / "body.cape.json");
+  const Scene scene = parse_scene(R"({"time": {"fps": 30, "frames": 2}, "cloth": {"nx": 4, "ny": 4},
+    "character": {"file": "body.X", "offset": [0, 1, 0],
+      "root": {"pivot": [0, -1, 0], "axis": [2, 0, 0],
+               "keys": [{"frame": 0, "translate": [0, 2, 0]}, {"frame": 10, "angle": 90}]}}})",
+                                  tmp.path() / "fall.json");
+  const CharacterSpec& spec = *scene.character;
+  // Frame 5: translation (0, 1, 0), 45 degrees about +x through (0, -1, 0), then the offset.
+  const Vec3 p(0.3, 0.5, -0.2);
+  const double c = std::cos(M_PI / 4), s = std::sin(M_PI / 4);
+  const Vec3 rel = p - Vec3(0, -1, 0);
+  const Vec3 expect = Vec3(0, -1, 0) + Vec3(rel.x(), c * rel.y() - s * rel.z(), s * rel.y() + c * rel.z()) +
+                      Vec3(0, 1, 0) + Vec3(0, 1, 0);
+  EXPECT_LT((character_placement(spec, 5) * p - expect).norm(), 1e-12);
+  EXPECT_LT((character_placement(spec, -3) * p - (p + Vec3(0, 3, 0))).norm(), 1e-12);  // held before
+  EXPECT_LT((character_placement(spec, 10) * p - character_placement(spec, 40) * p).norm(), 1e-15);  // and after
+
+  Character body(test::character_asset(), character_options(spec));
+  VecX still, moved;
+  body.pose(animation_time(spec, 5), still);
+  pose_at_frame(body, spec, 5, moved);
+  const Eigen::Affine3d m = character_placement(spec, 5) * body.placement().inverse();
+  for (int i : {0, 100, body.vertex_count() - 1})
+    EXPECT_LT((seg(moved, i) - m * Vec3(seg(still, i))).norm(), 1e-12) << "vertex " << i;
+  // Rigid: distances between vertices are kept.
+  EXPECT_NEAR((seg(moved, 0) - seg(moved, 100)).norm(), (seg(still, 0) - seg(still, 100)).norm(), 1e-12);
+
+  EXPECT_THROW(parse_scene(R"({"time": {"fps": 30, "frames": 2}, "cloth": {"nx": 4, "ny": 4},
+    "character": {"file": "body.X", "root": {"keys": [{"frame": 3}, {"frame": 3}]}}})",
+                           tmp.path() / "bad.json"),
+               InputError);
 }
 
 }  // namespace

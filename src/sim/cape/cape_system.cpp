@@ -7,21 +7,11 @@
 
 #include "sim/cape/anchor_track.h"
 #include "sim/character/cape_anchors.h"
+#include "sim/character/scene_character.h"
 #include "sim/make_system.h"
 
 namespace kf {
 
-namespace {
-
-CharacterOptions character_options(const CharacterSpec& s) {
-  CharacterOptions o;
-  o.animation = s.animation;
-  o.wrap = TimeWrap::kClamp;
-  o.placement = Affine(Eigen::Translation3d(s.offset));
-  return o;
-}
-
-}  // namespace
 
 CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, double fps, int steps, double h)
     : spec_(character), fps_(fps), h_(h), character_(character.file, character_options(character)),
@@ -39,7 +29,7 @@ CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, d
   std::vector<std::vector<Vec3>> anchors;
   VecX gathered;
   for (int n = 0; n <= steps + 1; ++n) {
-    character_.pose(animation_time_at(n), pose_);
+    pose_at_frame(character_, spec_, n * h_ * fps_, pose_);
     gather_vertices(pose_, anchor_ids, gathered);
     std::vector<Vec3> a(anchor_ids.size());
     for (size_t k = 0; k < a.size(); ++k) a[k] = seg(gathered, int(k));
@@ -69,7 +59,7 @@ double CapeSystem::animation_time_at(int n) const { return animation_time(spec_,
 
 VecX CapeSystem::body_at(int n) {
   VecX out;
-  character_.pose(animation_time_at(n), out);
+  pose_at_frame(character_, spec_, n * h_ * fps_, out);
   return out;
 }
 
@@ -85,7 +75,7 @@ void CapeSystem::initial_state(VecX& x, VecX& v) const {
 
 void CapeSystem::prepare(int n, const VecX& x) {
   if (posed_step_ != n) {
-    character_.pose(animation_time_at(n), pose_);
+    pose_at_frame(character_, spec_, n * h_ * fps_, pose_);
     body_->set_pose(pose_);
     posed_step_ = n;
   }

@@ -1,0 +1,14 @@
+#pragma once
+// The scene's character: loaded with the spec's animation and offset, posed at a scene frame (animation
+// time from the spec's time keys, then the root motion), so the cape, its pins and the drawn body agree.
+#include "scene/character_spec.h"
+#include "sim/character/character.h"
+
+namespace kf {
+
+CharacterOptions character_options(const CharacterSpec& spec);
+
+// Posed vertices (3n) at a (fractional) scene frame. Allocation-free when `out` has the size already.
+void pose_at_frame(Character& character, const CharacterSpec& spec, double frame, VecX& out);
+
+}  // namespace kf
