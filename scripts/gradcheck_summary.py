@@ -1,11 +1,21 @@
 #!/usr/bin/env python3
-"""Summarises a gradcheck_table.py CSV as the README's markdown table: one row per scene and adjoint.
+"""Summarises a gradcheck_table.py CSV as the README's markdown table: one row per scene and adjoint, or
+with `rows`, one row per check (the long-horizon table).
 
-Usage: scripts/gradcheck_summary.py tests/results/gradcheck_scenes.csv"""
+Usage: scripts/gradcheck_summary.py tests/results/gradcheck_scenes.csv
+       scripts/gradcheck_summary.py tests/results/long_horizon.csv rows"""
 import csv, sys
 from collections import OrderedDict
 
 rows = list(csv.DictReader(open(sys.argv[1])))
+if sys.argv[2:] == ["rows"]:
+    print("| steps | adjoint | checked (kinks) | max_rel_error | cosine | ‖adjoint − fd‖/‖fd‖ | fd_spread | gradient norm |")
+    print("|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r['steps']} | {r['adjoint']} | {r['checked']} ({r['kinks']}) | {float(r['max_rel_error']):.1e} | "
+              f"{float(r['cosine']):.7f} | {float(r['rel_error_norm']):.1e} | {float(r['fd_spread']):.1e} | "
+              f"{float(r['grad_norm']):.2g} |")
+    sys.exit(0)
 groups = OrderedDict()
 for r in rows:
     groups.setdefault((r["scene"], r["adjoint"]), []).append(r)

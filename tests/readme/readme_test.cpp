@@ -1,0 +1,136 @@
+// The README's numbers against the committed results they come from. A value or table the README shows is
+// written as <!--gen:COMMAND-->TEXT<!--/gen--> (the comment is invisible on the rendered page); COMMAND runs
+// in the repository root (usually scripts/result or a summary script over tests/results/) and TEXT must be
+// what it prints. KEYFRAME_UPDATE_README=1 rewrites every TEXT from its command instead of checking.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/atomic_file.h"
+
+namespace kf {
+namespace {
+
+const std::string kOpen = "<!--gen:", kClose = "<!--/gen-->";
+
+struct Generated {
+  std::string command;
+  size_t text_begin = 0, text_end = 0;  // TEXT's byte range in the README
+};
+
+std::string trimmed(const std::string& s) {
+  const size_t a = s.find_first_not_of(" \n\t"), b = s.find_last_not_of(" \n\t");
+  return a == std::string::npos ? "" : s.substr(a, b - a + 1);
+}
+
+int line_of(const std::string& text, size_t pos) { return 1 + int(std::count(text.begin(), text.begin() + pos, '\n')); }
+
+std::vector<Generated> generated_parts(const std::string& readme) {
+  std::vector<Generated> out;
+  for (size_t at = readme.find(kOpen); at != std::string::npos; at = readme.find(kOpen, at + 1)) {
+    const size_t end_cmd = readme.find("-->", at);
+    const size_t close = readme.find(kClose, at);
+    const size_t next = readme.find(kOpen, at + 1);
+    if (end_cmd == std::string::npos || close == std::string::npos || close < end_cmd ||
+        (next != std::string::npos && next < close))
+      throw std::runtime_error("README.md:" + std::to_string(line_of(readme, at)) + ": " + kOpen +
+                               " without its " + kClose);
+    const std::string command = readme.substr(at + kOpen.size(), end_cmd - at - kOpen.size());
+    if (command.find("--") != std::string::npos)
+      throw std::runtime_error("README.md:" + std::to_string(line_of(readme, at)) +
+                               ": \"--\" ends an HTML comment early; use KEY=VALUE options");
+    out.push_back({command, end_cmd + 3, close});
+  }
+  return out;
+}
+
+// stdout of `command` run in the repository root (once per test process); throws when it fails.
+std::string output_of(const std::string& command) {
+  static std::map<std::string, std::string> cache;
+  if (auto it = cache.find(command); it != cache.end()) return it->second;
+  const std::string cmd = "cd '" KEYFRAME_SOURCE_DIR "' && " + command;
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
+  if (pclose(p) != 0) throw std::runtime_error("`" + command + "` failed");
+  return cache[command] = out;
+}
+
+// One line per README value that differs from its command's output.
+std::vector<std::string> mismatches(const std::string& readme) {
+  std::vector<std::string> out;
+  for (const Generated& g : generated_parts(readme)) {
+    const std::string shown = trimmed(readme.substr(g.text_begin, g.text_end - g.text_begin));
+    const std::string wanted = trimmed(output_of(g.command));
+    if (shown != wanted)
+      out.push_back("README.md:" + std::to_string(line_of(readme, g.text_begin)) + ": shows \"" + shown +
+                    "\" but `" + g.command + "` gives \"" + wanted + "\"");
+  }
+  return out;
+}
+
+// The README with every TEXT replaced by its command's output (tables keep a blank line on each side).
+std::string regenerated(const std::string& readme) {
+  std::string out;
+  size_t copied = 0;
+  for (const Generated& g : generated_parts(readme)) {
+    out += readme.substr(copied, g.text_begin - copied);
+    const std::string wanted = trimmed(output_of(g.command));
+    const bool block = readme.compare(g.text_begin, 1, "\n") == 0;
+    out += block ? "\n\n" + wanted + "\n\n" : wanted;
+    copied = g.text_end;
+  }
+  return out + readme.substr(copied);
+}
+
+std::string readme_text() {
+  std::ifstream in(KEYFRAME_SOURCE_DIR "/README.md", std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+TEST(Readme, EveryCheckedValueMatchesTheCommittedResults) {
+  const std::string readme = readme_text();
+  if (std::getenv("KEYFRAME_UPDATE_README")) {
+    write_file_atomic(KEYFRAME_SOURCE_DIR "/README.md", regenerated(readme));
+    GTEST_SKIP() << "rewrote README.md from its commands";
+  }
+  const auto parts = generated_parts(readme);
+  EXPECT_GE(parts.size(), 20u) << "the README's checked values have gone missing";
+  for (const std::string& m : mismatches(readme)) ADD_FAILURE() << m;
+}
+
+TEST(Readme, AHandEditedValueOrAnUnclosedMarkerFails) {
+  const std::string readme = readme_text();
+  const auto parts = generated_parts(readme);
+  ASSERT_FALSE(parts.empty());
+  // Change the first digit of every checked value in turn: each edit alone is caught.
+  int edited = 0;
+  for (const Generated& g : parts) {
+    std::string copy = readme;
+    size_t d = copy.find_first_of("0123456789", g.text_begin);
+    if (d == std::string::npos || d >= g.text_end) continue;
+    copy[d] = copy[d] == '9' ? '8' : char(copy[d] + 1);
+    const auto found = mismatches(copy);
+    EXPECT_EQ(found.size(), 1u) << "an edit at README.md:" << line_of(readme, d) << " went unnoticed";
+    if (++edited == 5) break;  // each check runs every command: five edits are enough
+  }
+  EXPECT_EQ(edited, 5);
+  EXPECT_THROW(generated_parts("a <!--gen:echo 1-->1 and no close"), std::runtime_error);
+  EXPECT_THROW(generated_parts("<!--gen:scripts/result x.csv y --fmt %d-->1<!--/gen-->"), std::runtime_error);
+  EXPECT_EQ(regenerated("x <!--gen:echo 2-->1<!--/gen--> y"), "x <!--gen:echo 2-->2<!--/gen--> y");
+}
+
+}  // namespace
+}  // namespace kf
