@@ -13,6 +13,8 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/overloaded.h"
+#include "render/export/animated_gltf.h"
+#include "render/export/point_cache.h"
 #include "render/frame_renderer.h"
 
 namespace kf::render {
@@ -21,16 +23,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
+enum class Layout { kPerFrame, kAnimatedGltf, kPointCache };
 struct Format {
   const char* name;       // --format
-  const char* assimp_id;  // assimp's exporter id
+  const char* assimp_id;  // assimp's exporter id (per-frame files)
   const char* extension;
-  bool one_file;          // all frames in one file
+  Layout layout;
 };
 constexpr Format kFormats[] = {
-    {"obj", "obj", ".obj", false},
-    {"ply", "plyb", ".ply", false},
-    {"gltf2", "gltf2", ".gltf", true},
+    {"gltf2", "", ".gltf", Layout::kAnimatedGltf},
+    {"pc2", "", ".pc2", Layout::kPointCache},
+    {"obj", "obj", ".obj", Layout::kPerFrame},
+    {"ply", "plyb", ".ply", Layout::kPerFrame},
 };
 
 // A named triangle mesh with per-vertex normals, single precision like the file formats.
@@ -73,31 +77,24 @@ aiMaterial* to_ai_material(const std::string& name, const Vec3& c) {
   return mat;
 }
 
-// One scene: a root with one child node per group (a frame), each holding its meshes.
-std::unique_ptr<aiScene> make_scene(const std::vector<std::pair<std::string, std::vector<ExportMesh>>>& groups) {
+// One frame as a scene: a root with one child node per object, so cape and body stay separate objects.
+std::unique_ptr<aiScene> make_scene(const std::vector<ExportMesh>& objects) {
   auto scene = std::make_unique<aiScene>();
   scene->mRootNode = new aiNode("keyframe");
-  unsigned meshes = 0;
-  for (const auto& g : groups) meshes += unsigned(g.second.size());
-  scene->mNumMeshes = meshes;
-  scene->mMeshes = new aiMesh*[meshes];
-  scene->mNumMaterials = meshes;
-  scene->mMaterials = new aiMaterial*[meshes];
-  scene->mRootNode->mNumChildren = unsigned(groups.size());
-  scene->mRootNode->mChildren = new aiNode*[groups.size()];
-  unsigned k = 0;
-  for (size_t gi = 0; gi < groups.size(); ++gi) {
-    auto* node = new aiNode(groups[gi].first);
+  const unsigned n = unsigned(objects.size());
+  scene->mNumMeshes = scene->mNumMaterials = n;
+  scene->mMeshes = new aiMesh*[n];
+  scene->mMaterials = new aiMaterial*[n];
+  scene->mRootNode->mNumChildren = n;
+  scene->mRootNode->mChildren = new aiNode*[n];
+  for (unsigned k = 0; k < n; ++k) {
+    auto* node = new aiNode(objects[k].name);
     node->mParent = scene->mRootNode;
-    scene->mRootNode->mChildren[gi] = node;
-    node->mNumMeshes = unsigned(groups[gi].second.size());
-    node->mMeshes = new unsigned[node->mNumMeshes];
-    for (size_t j = 0; j < groups[gi].second.size(); ++j, ++k) {
-      const ExportMesh& m = groups[gi].second[j];
-      scene->mMaterials[k] = to_ai_material(m.name, m.color);
-      scene->mMeshes[k] = to_ai_mesh(m, k);
-      node->mMeshes[j] = k;
-    }
+    node->mNumMeshes = 1;
+    node->mMeshes = new unsigned[1]{k};
+    scene->mRootNode->mChildren[k] = node;
+    scene->mMaterials[k] = to_ai_material(objects[k].name, objects[k].color);
+    scene->mMeshes[k] = to_ai_mesh(objects[k], k);
   }
   return scene;
 }
@@ -155,6 +152,24 @@ std::vector<ExportMesh> frame_meshes(const RunData& run, int frame, const Bounds
   return out;
 }
 
+// Every object over frames [begin, end): its triangles (the same every frame) and per-frame vertices.
+std::vector<MovingMesh> moving_meshes(const fs::path& run_dir, const RunData& run, int begin, int end,
+                                      const Bounds& bounds, FrameGeometry& g) {
+  std::vector<MovingMesh> out;
+  for (int f = begin; f < end; ++f) {
+    std::vector<ExportMesh> frame = frame_meshes(run, f, bounds, g);
+    if (out.empty())
+      for (const ExportMesh& e : frame) out.push_back({e.name, e.color, e.indices, {}, {}});
+    for (size_t k = 0; k < frame.size(); ++k) {
+      if (k >= out.size() || frame[k].indices != out[k].indices)
+        throw InputError(run_dir.string() + ": frame " + std::to_string(f) + ": the meshes change between frames; export per frame (obj, ply)");
+      out[k].positions.push_back(std::move(frame[k].p));
+      out[k].normals.push_back(std::move(frame[k].n));
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<std::string> export_format_names() {
@@ -179,10 +194,12 @@ std::vector<fs::path> export_run(const ExportRequest& r) {
     throw InputError("frames " + std::to_string(begin) + ":" + std::to_string(r.frame_end) + " out of range: " +
                      r.run_dir.string() + " has frames 0.." + std::to_string(F - 1) + " (A:B exports A..B-1)");
   Assimp::Exporter exporter;
-  bool available = false;
-  for (size_t k = 0; k < exporter.GetExportFormatCount(); ++k)
-    available = available || std::string(exporter.GetExportFormatDescription(k)->id) == format->assimp_id;
-  if (!available) throw InputError(std::string("this assimp has no \"") + format->assimp_id + "\" exporter");
+  if (format->layout == Layout::kPerFrame) {
+    bool available = false;
+    for (size_t k = 0; k < exporter.GetExportFormatCount(); ++k)
+      available = available || std::string(exporter.GetExportFormatDescription(k)->id) == format->assimp_id;
+    if (!available) throw InputError(std::string("this assimp has no \"") + format->assimp_id + "\" exporter");
+  }
 
   const fs::path dir = r.run_dir / "export";
   const fs::path partial = dir / (".partial_" + std::to_string(::getpid()));
@@ -192,24 +209,25 @@ std::vector<fs::path> export_run(const ExportRequest& r) {
   const Bounds bounds = scene_bounds(run.scene, run.trajectory, run.meshes ? &*run.meshes : nullptr);
   FrameGeometry g;
   char name[64];
-  auto write = [&](const aiScene& scene, const std::string& file) {
-    if (exporter.Export(&scene, format->assimp_id, (partial / file).string()) != aiReturn_SUCCESS) {
-      fs::remove_all(partial, ec);
-      throw OutputError((dir / file).string() + ": export failed (" + exporter.GetErrorString() + ")");
-    }
-  };
   try {
-    if (format->one_file) {
-      std::vector<std::pair<std::string, std::vector<ExportMesh>>> groups;
+    if (format->layout == Layout::kPerFrame) {
       for (int f = begin; f < end; ++f) {
         std::snprintf(name, sizeof name, "frame_%04d", f);
-        groups.emplace_back(name, frame_meshes(run, f, bounds, g));
+        const std::string file = name + std::string(format->extension);
+        if (exporter.Export(make_scene(frame_meshes(run, f, bounds, g)).get(), format->assimp_id,
+                            (partial / file).string()) != aiReturn_SUCCESS)
+          throw OutputError((dir / file).string() + ": export failed (" + exporter.GetErrorString() + ")");
       }
-      write(*make_scene(groups), run.scene.name + format->extension);
     } else {
-      for (int f = begin; f < end; ++f) {
-        std::snprintf(name, sizeof name, "frame_%04d", f);
-        write(*make_scene({{name, frame_meshes(run, f, bounds, g)}}), name + std::string(format->extension));
+      const std::vector<MovingMesh> objects = moving_meshes(r.run_dir, run, begin, end, bounds, g);
+      if (format->layout == Layout::kAnimatedGltf) {
+        write_animated_gltf(partial / (run.scene.name + ".gltf"), partial / (run.scene.name + ".bin"), objects,
+                            run.scene.time.fps);
+      } else {
+        for (const MovingMesh& m : objects) {
+          write_rest_obj(partial / (m.name + ".obj"), m);
+          write_pc2(partial / (m.name + ".pc2"), m, begin);
+        }
       }
     }
   } catch (...) {

@@ -10,17 +10,22 @@ namespace kf {
 
 void add_export_command(CLI::App& app) {
   auto* sub = app.add_subcommand(
-      "export", "write the run's meshes per frame to RUN_DIR/export/ (OBJ or PLY per frame, or one glTF 2)");
+      "export",
+      "write the run's animation to RUN_DIR/export/: one animated glTF 2 (default), a point cache (.pc2 + rest "
+      "OBJ per object, for Blender's Mesh Cache modifier or Maya), or OBJ/PLY per frame");
   auto req = std::make_shared<render::ExportRequest>();
   auto frames = std::make_shared<std::string>();
   std::string names;
   for (const auto& n : render::export_format_names()) names += (names.empty() ? "" : "|") + n;
   sub->add_option("RUN_DIR", req->run_dir, "run directory holding scene.json and trajectory.bin")->required();
-  sub->add_option("--format", req->format, "file format (" + names + "); gltf2 puts all frames in one file")
+  sub->add_option("--format", req->format, "file format (" + names + ")")
       ->capture_default_str();
   sub->add_option("--frames", *frames, "frames A:B exports A..B-1 (default: all)");
-  sub->footer("Meshes: \"cloth\" or \"agents\", plus each mesh of RUN_DIR/meshes.bin; metres, Y up.\n"
-              "Example: keyframe export out/ringtoss --format gltf2");
+  sub->footer("Objects: \"cloth\" or \"agents\", plus each mesh of RUN_DIR/meshes.bin (\"body\"); metres, Y up.\n"
+              "Examples: keyframe export out/ring-toss                 (out/ring-toss/export/ring-toss.gltf + .bin)\n"
+              "          keyframe export out/cape-blend --format pc2   (cloth.obj + cloth.pc2, body.obj + body.pc2)\n"
+              "Blender: File > Import > glTF 2.0 plays the .gltf; for a .pc2, import NAME.obj (Split by: keep\n"
+              "vertex order) and add a Mesh Cache modifier reading NAME.pc2 (see the README).");
   sub->callback([=] {
     render::ExportRequest r = *req;
     if (!frames->empty()) {
