@@ -24,8 +24,8 @@ void add_export_command(CLI::App& app) {
   sub->footer("Objects: \"cloth\" or \"agents\", plus each mesh of RUN_DIR/meshes.bin (\"body\"); metres, Y up.\n"
               "Examples: keyframe export out/ring-toss                 (out/ring-toss/export/ring-toss.gltf + .bin)\n"
               "          keyframe export out/cape-blend --format pc2   (cloth.obj + cloth.pc2, body.obj + body.pc2)\n"
-              "Blender: File > Import > glTF 2.0 plays the .gltf; for a .pc2, import NAME.obj (Split by: keep\n"
-              "vertex order) and add a Mesh Cache modifier reading NAME.pc2 (see the README).");
+              "Blender: blender -P scripts/blender_import.py -- RUN_DIR [--pc2] opens either at the run's frame\n"
+              "rate; by hand, see the README's \"Bringing a run into Blender\".");
   sub->callback([=] {
     render::ExportRequest r = *req;
     if (!frames->empty()) {
