@@ -52,6 +52,17 @@ void shape_measures(const ShapeKeyframe& k, const VecX& x, nlohmann::json& m) {
   m["inside_fraction"] = double(inside) / p;
   m["min_spacing"] = *std::min_element(nn.begin(), nn.end());
   m["median_spacing"] = median(nn);
+  // Filled, not clumped: the fraction of the region's sample points with an agent within the radius.
+  const std::vector<Vec2> samples = region_samples(k.polygon, k.coverage_spacing);
+  int covered = 0;
+  for (const Vec2& q : samples) {
+    bool near = false;
+    for (int i = 0; i < p && !near; ++i)
+      near = Vec2(x[3 * i] - q.x(), x[3 * i + 2] - q.y()).squaredNorm() <= k.coverage_radius * k.coverage_radius;
+    covered += near;
+  }
+  m["coverage_fraction"] = samples.empty() ? 1.0 : double(covered) / double(samples.size());
+  m["coverage_radius"] = k.coverage_radius;
 }
 
 void center_of_mass_measures(const Scene& scene, const ObjectiveSpec& o, const CenterOfMassKeyframe& k,

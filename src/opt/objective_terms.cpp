@@ -1,8 +1,10 @@
 #include "opt/objective_terms.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "core/error.h"
 #include "core/overloaded.h"
 
 namespace kf {
@@ -106,10 +108,17 @@ class CenterOfMassTerm : public ObjectiveTerm {
 // as a polygon in (x, z) (negative inside), m the margin: agents are pulled to at least m inside. With
 // m = 0 this is ½w Σ dist(x_i, S)² over agents outside. The gradient w (s + m) ∇s is continuous across the
 // boundary (∇s is the unit direction away from the closest boundary point, outward).
+// Agents into a polygon on the ground: ½w Σ s_i² with s_i the distance outside the region (plus a margin
+// inside the boundary when margin > 0). With coverage, the region filled too: ½w_c Σ_j max(0, D_j − r²)²
+// over the region samples q_j, with D_j a soft minimum of the squared distances ‖q_j − x_i‖² (log-sum-exp
+// at temperature (r/4)², smooth where the nearest agent changes).
 class ShapeTerm : public ObjectiveTerm {
  public:
   ShapeTerm(const ObjectiveSpec& s, const ShapeKeyframe& k, int p)
-      : frame_(s.frame), w_(s.weight), margin_(k.margin), ids_(members(s, p)), poly_(k.polygon) {}
+      : frame_(s.frame), w_(s.weight), margin_(k.margin), ids_(members(s, p)), poly_(k.polygon),
+        wc_(k.coverage_weight), r2_(k.coverage_radius * k.coverage_radius), tau_(r2_ / 16),
+        samples_(k.coverage_weight > 0 ? region_samples(k.polygon, k.coverage_spacing) : std::vector<Vec2>{}),
+        d2_(ids_.size()) {}
   std::string name() const override { return "shape"; }
   int frame() const override { return frame_; }
   double eval(const VecX& x, const VecX&, VecX& gx, VecX&) const override {
@@ -137,14 +146,41 @@ class ShapeTerm : public ObjectiveTerm {
       gx[3 * i] += w_ * g.x();
       gx[3 * i + 2] += w_ * g.y();
     }
+    for (const Vec2& q : samples_) val += coverage(q, x, gx);
     return double(val);
   }
 
  private:
+  // One region sample's coverage penalty; adds its gradient.
+  double coverage(const Vec2& q, const VecX& x, VecX& gx) const {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < ids_.size(); ++k) {
+      const int i = ids_[k];
+      d2_[k] = Vec2(x[3 * i] - q.x(), x[3 * i + 2] - q.y()).squaredNorm();
+      nearest = std::min(nearest, d2_[k]);
+    }
+    if (nearest - r2_ <= 0) return 0;  // D ≤ nearest: an agent is within r, no penalty
+    double sum = 0;
+    for (size_t k = 0; k < ids_.size(); ++k) sum += std::exp(-(d2_[k] - nearest) / tau_);
+    const double soft = nearest - tau_ * std::log(sum), h = soft - r2_;
+    if (h <= 0) return 0;
+    for (size_t k = 0; k < ids_.size(); ++k) {
+      const int i = ids_[k];
+      const double dsoft = std::exp(-(d2_[k] - nearest) / tau_) / sum;  // ∂D/∂d²_i
+      const double c = wc_ * h * dsoft * 2;
+      gx[3 * i] += c * (x[3 * i] - q.x());
+      gx[3 * i + 2] += c * (x[3 * i + 2] - q.y());
+    }
+    return 0.5 * wc_ * h * h;
+  }
+
   int frame_;
   double w_, margin_;
   std::vector<int> ids_;
   std::vector<Vec2> poly_;
+  double wc_, r2_, tau_;
+  std::vector<Vec2> samples_;
+  mutable std::vector<double> d2_;  // per member, reused by every sample (evaluations are sequential)
 };
 
 // ½w Σ (‖r⊥_i‖ − R)², r⊥ the offset of x_i from the cylinder axis: cloth onto an arch.
@@ -189,6 +225,24 @@ std::unique_ptr<ObjectiveTerm> make_objective_term(const ObjectiveSpec& s, int p
           [&](const ArchKeyframe& k) -> Term { return std::make_unique<ArchTerm>(s, k, particles); },
       },
       s.kind);
+}
+
+std::vector<Vec2> region_samples(const std::vector<Vec2>& polygon, double spacing) {
+  Vec2 lo = polygon.front(), hi = lo;
+  for (const Vec2& p : polygon) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  // Cell centres of a grid over the bounding box, so opposite sides are sampled alike.
+  const int nx = std::max(1, int(std::lround((hi.x() - lo.x()) / spacing))),
+            nz = std::max(1, int(std::lround((hi.y() - lo.y()) / spacing)));
+  if (double(nx) * nz > 1e5)
+    throw InputError("shape keyframe: coverage spacing " + std::to_string(spacing) + " m gives more than 100,000 samples");
+  const Vec2 start = 0.5 * (lo + hi) - 0.5 * spacing * Vec2(nx - 1, nz - 1);
+  std::vector<Vec2> out;
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const Vec2 q = start + spacing * Vec2(i, j);
+      if (polygon_contains(polygon, q)) out.push_back(q);
+    }
+  return out;
 }
 
 }  // namespace kf

@@ -29,5 +29,8 @@ Vec2 closest_point_in_polygon(const std::vector<Vec2>& polygon, const Vec2& q, b
 // Closest point of the polygon's boundary (its edges) to q, inside or out.
 Vec2 closest_point_on_boundary(const std::vector<Vec2>& polygon, const Vec2& q);
 bool polygon_contains(const std::vector<Vec2>& polygon, const Vec2& q);
+// The points of a square grid of `spacing` (cell centres, centred in the polygon's bounding box) inside the polygon: where
+// a shape keyframe asks for an agent nearby. Throws InputError past 100,000 points.
+std::vector<Vec2> region_samples(const std::vector<Vec2>& polygon, double spacing);
 
 }  // namespace kf

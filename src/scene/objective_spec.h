@@ -33,6 +33,12 @@ struct ShapeKeyframe {
   static constexpr const char* kName = "shape";
   std::vector<Vec2> polygon;  // closed polygon on the ground, (x, z), metres
   double margin = 0;          // metres
+  // Filling the region: every point of a grid of `spacing` inside the polygon should have an agent within
+  // `radius` (default: the flock's avoidance radius; spacing default radius / 2). `coverage_weight` 0 leaves
+  // the term off; the figure measure coverage_fraction uses radius and spacing either way.
+  double coverage_weight = 0;
+  double coverage_radius = 0;   // metres
+  double coverage_spacing = 0;  // metres
 };
 // Cloth: particles pulled onto a cylinder (an arch).
 struct ArchKeyframe {

@@ -55,6 +55,11 @@ ObjectiveKind parse_shape(Block& b, const ObjectiveSpec&, const Scene& s) {
   ShapeKeyframe k;
   k.polygon = b.points2("polygon", 3);
   k.margin = b.number("margin", 0.0, 0.0, 1e4);
+  Block c = b.child("coverage");
+  k.coverage_weight = c.number("weight", 0.0, 0.0, 1e12);
+  k.coverage_radius = c.number("radius", s.flock->avoidance.radius, 1e-3, 1e4);
+  k.coverage_spacing = c.number("spacing", 0.5 * k.coverage_radius, 1e-3, 1e4);
+  c.finish();
   return k;
 }
 

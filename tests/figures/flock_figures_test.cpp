@@ -57,8 +57,10 @@ TEST(FlockFigures, SquareThenCrossReduced) {
     "flock": {"agents": 50, )" + std::string(kForces) + R"(,
               "spawn": {"radius": 4.2, "velocity": [0, 0, 1.5]}},
     "objectives": [
-      {"type": "shape", "frame": 15, "margin": 0.3, "polygon": [[-3.5, 1], [3.5, 1], [3.5, 8], [-3.5, 8]]},
-      {"type": "shape", "frame": 30, "margin": 0.3, "polygon": [[-1.5, 3], [1.5, 3], [1.5, 6.5], [5, 6.5],
+      {"type": "shape", "frame": 15, "margin": 0.3, "coverage": {"weight": 0.3},
+       "polygon": [[-3.5, 1], [3.5, 1], [3.5, 8], [-3.5, 8]]},
+      {"type": "shape", "frame": 30, "margin": 0.3, "coverage": {"weight": 0.3},
+       "polygon": [[-1.5, 3], [1.5, 3], [1.5, 6.5], [5, 6.5],
         [5, 9.5], [1.5, 9.5], [1.5, 13], [-1.5, 13], [-1.5, 9.5], [-5, 9.5], [-5, 6.5], [-1.5, 6.5]]}],
     "controls": {"kind": "per_frame", "alpha": 0.01},
     "optimizer": {"max_evaluations": 200, "ftol_rel": 1e-7}})",
@@ -68,6 +70,7 @@ TEST(FlockFigures, SquareThenCrossReduced) {
   for (const auto& m : o.measures) {
     SCOPED_TRACE(m.dump());
     EXPECT_GE(m["inside_fraction"].get<double>(), 0.98);
+    EXPECT_GE(m["coverage_fraction"].get<double>(), 0.95);  // the whole shape filled, not a clump in it
     EXPECT_GT(m["min_spacing"].get<double>(), 0.3);  // no clumps
     EXPECT_GT(m["median_spacing"].get<double>(), 0.6);
   }

@@ -37,8 +37,32 @@ TEST(ObjectiveTerms, GradientsMatchFiniteDifferences) {
   ObjectiveSpec shape{.kind = ShapeKeyframe{{Vec2(-0.5, -0.5), Vec2(0.5, -0.5), Vec2(0.5, 0.5), Vec2(-0.5, 0.5)}},
                       .frame = 1, .weight = 1.5};
   ObjectiveSpec arch{.kind = ArchKeyframe{Vec3(0, -1, 0), Vec3(0, 0, 1), 1.5}, .frame = 1, .weight = 1.0};
+  // A region larger than the agents' spread: its coverage term is active at several samples.
+  ShapeKeyframe filled{{Vec2(-2.5, -2.5), Vec2(2.5, -2.5), Vec2(2.5, 2.5), Vec2(-2.5, 2.5)}, 0.3, 3.0, 0.7, 0.5};
+  ObjectiveSpec coverage{.kind = filled, .frame = 1, .weight = 1.5};
   for (unsigned seed : {1u, 2u, 3u})
-    for (const auto& s : {pos, vel, com, shape, arch}) check_term(s, 6, seed);
+    for (const auto& s : {pos, vel, com, shape, arch, coverage}) check_term(s, 6, seed);
+}
+
+TEST(ObjectiveTerms, CoverageIsZeroWhenTheRegionIsFilledAndPullsAnAgentIntoAGap) {
+  const ShapeKeyframe square{{Vec2(0, 0), Vec2(2, 0), Vec2(2, 2), Vec2(0, 2)}, 0.0, 1.0, 0.75, 0.5};
+  const std::vector<Vec2> samples = region_samples(square.polygon, 0.5);
+  EXPECT_EQ(samples.size(), 16u);  // cell centres of a 4 x 4 grid: 0.25 ... 1.75
+  // Four agents at the quarter centres cover every sample within 0.75 m.
+  const std::vector<Vec2> at = {{0.5, 0.5}, {1.5, 0.5}, {0.5, 1.5}, {1.5, 1.5}};
+  VecX x = VecX::Zero(12), v = VecX::Zero(12), gx = VecX::Zero(12), gv = gx;
+  for (int i = 0; i < 4; ++i) x[3 * i] = at[i].x(), x[3 * i + 2] = at[i].y();
+  ObjectiveSpec s{.kind = square, .frame = 1, .weight = 0.0};
+  EXPECT_EQ(make_objective_term(s, 4)->eval(x, v, gx, gv), 0.0);
+  EXPECT_EQ(gx.norm(), 0.0);
+  // The agent of the top-right quarter moves to the bottom-left one: its corner is empty.
+  x[9] = 0.6, x[11] = 0.4;
+  const double val = make_objective_term(s, 4)->eval(x, v, gx, gv);
+  EXPECT_GT(val, 0.0);
+  // Descending the gradient moves the agents nearest the empty corner (1.75, 1.75) towards it: the one at
+  // (1.5, 0.5) up in z, the one at (0.5, 1.5) along x.
+  EXPECT_LT(gx[3 * 1 + 2], 0.0);
+  EXPECT_LT(gx[3 * 2], 0.0);
 }
 
 TEST(ObjectiveTerms, ShapeIsZeroInsideAndPullsOutsidePointsToTheBoundary) {
