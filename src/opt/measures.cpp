@@ -80,8 +80,28 @@ void center_of_mass_measures(const Scene& scene, const ObjectiveSpec& o, const C
   m["error_over_path"] = length > 0 ? err / length : 0.0;
 }
 
-// The race: one agent of a flock from last to first along the flock's heading.
-void race_measures(const ObjectiveSpec& o, const PositionKeyframe& k, const Trajectory& t, int f, nlohmann::json& m) {
+// Groups of the flock at one frame: agents linked when closer than `radius` (union-find).
+int flock_groups(const VecX& x, double radius) {
+  const int p = int(x.size() / 3);
+  std::vector<int> up(static_cast<size_t>(p));
+  for (int i = 0; i < p; ++i) up[size_t(i)] = i;
+  auto root = [&](int i) {
+    while (up[size_t(i)] != i) i = up[size_t(i)] = up[size_t(up[size_t(i)])];
+    return i;
+  };
+  int groups = p;
+  for (int i = 0; i < p; ++i)
+    for (int j = i + 1; j < p; ++j)
+      if ((seg(x, i) - seg(x, j)).squaredNorm() <= radius * radius) {
+        const int a = root(i), b = root(j);
+        if (a != b) up[size_t(a)] = b, --groups;
+      }
+  return groups;
+}
+
+// The race: one agent of a flock from last to first along the flock's heading, the flock one group.
+void race_measures(const Scene& scene, const ObjectiveSpec& o, const PositionKeyframe& k, const Trajectory& t, int f,
+                   nlohmann::json& m) {
   const VecX& x = t.x[f];
   const int a = o.particles[0];
   Vec3 heading = mean_of(t.x[f], {}) - mean_of(t.x[0], {});
@@ -99,6 +119,19 @@ void race_measures(const ObjectiveSpec& o, const PositionKeyframe& k, const Traj
   m["rank_at_end"] = r1;
   m["last_at_start"] = r0 == 0;
   m["first_at_end"] = r1 == p - 1;
+  m["racer_rank"] = p - r1;  // 1: the front of the flock along its heading
+  // How far ahead of the next agent: the racer should lead the flock, not leave it.
+  double next = -std::numeric_limits<double>::infinity();
+  for (int i = 0; i < p; ++i)
+    if (i != a) next = std::max(next, seg(x, i).dot(heading));
+  const double radius = scene.flock->centering.radius;
+  m["racer_lead"] = seg(x, a).dot(heading) - next;
+  m["racer_within_front"] = m["racer_lead"].get<double>() <= radius;
+  // One group throughout: links up to the centering radius connect every agent at every frame up to f.
+  int most = 0;
+  for (int g = 0; g <= f; ++g) most = std::max(most, flock_groups(t.x[size_t(g)], radius));
+  m["flock_groups_max"] = most;
+  m["flock_connected"] = most == 1;
   m["rms_error"] = (seg(x, a) - k.targets[0]).norm();
 }
 
@@ -115,7 +148,7 @@ double target_squared_error(const ObjectiveSpec& o, const std::vector<Vec3>& tar
 
 void position_measures(const Scene& scene, const ObjectiveSpec& o, const PositionKeyframe& k, const Trajectory& t,
                        int f, nlohmann::json& m) {
-  if (scene.flock && o.particles.size() == 1) return race_measures(o, k, t, f, m);
+  if (scene.flock && o.particles.size() == 1) return race_measures(scene, o, k, t, f, m);
   int n = 0;
   const double sum = target_squared_error(o, k.targets, t.x[f], n);
   m["rms_error"] = std::sqrt(sum / n);

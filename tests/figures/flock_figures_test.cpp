@@ -117,17 +117,25 @@ TEST(FlockFigures, RaceReduced) {
     "controls": {"kind": "per_frame", "alpha": 0.01},
     "optimizer": {"max_evaluations": 150, "ftol_rel": 1e-8},)";
   const int runner = last_along_z(parse_scene(head + R"("objectives": []})", "race.json"));
+  std::string others;  // the rest of the flock: kept together in a filled region just behind the racer
+  for (int i = 0; i < 20; ++i)
+    if (i != runner) others += (others.empty() ? "" : ", ") + std::to_string(i);
   const Scene scene = parse_scene(head + R"("objectives": [
       {"type": "center_of_mass", "frame": 20, "weight": 10, "target": [0, 0, 2.5]},
       {"type": "center_of_mass", "frame": 40, "weight": 10, "target": [0, 0, 5]},
       {"type": "position", "frame": 40, "weight": 10, "particles": [)" + std::to_string(runner) +
-                                      R"(], "targets": [[0, 0, 10.5]]}]})",
+                                      R"(], "targets": [[0, 0, 9.3]]},
+      {"type": "shape", "frame": 40, "weight": 10, "particles": [)" + others + R"(],
+       "polygon": [[-3, 2], [3, 2], [3, 8], [-3, 8]], "coverage": {"weight": 0.3, "radius": 2}}]})",
                                   "race.json");
   const Optimised o = optimise(scene);
   const auto& race = o.measures[2];
   SCOPED_TRACE(o.measures.dump());
   EXPECT_TRUE(race["last_at_start"].get<bool>());
   EXPECT_TRUE(race["first_at_end"].get<bool>());
+  EXPECT_EQ(race["racer_rank"], 1);
+  EXPECT_TRUE(race["racer_within_front"].get<bool>()) << "the racer left the flock behind";
+  EXPECT_TRUE(race["flock_connected"].get<bool>()) << "the flock split";
   EXPECT_LT(std::abs(o.measures[1]["error"].get<double>()), 0.3);  // the flock kept its straight path
 }
 
