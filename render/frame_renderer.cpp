@@ -56,4 +56,11 @@ Image FrameRenderer::render(int frame, double orbit) {
   return backend_->render(geometry_, cam, run_.scene.render, settings_);
 }
 
+Image FrameRenderer::render_path(const std::vector<int>& frames) {
+  if (!run_.scene.flock) throw InputError("figure: --overlay draws a flock's path; this run is not a flock");
+  build_frame_geometry(run_.scene, run_.trajectory, frames.back(), bounds_, geometry_, run_.meshes ? &*run_.meshes : nullptr);
+  add_flock_path(run_.scene, run_.trajectory, frames, geometry_);
+  return backend_->render(geometry_, camera_, run_.scene.render, settings_);
+}
+
 }  // namespace kf::render

@@ -30,6 +30,9 @@ class FrameRenderer {
   FrameRenderer(const RunData& run, const std::string& backend, RenderSettings settings);
   // Frame `frame` (0 <= frame < trajectory frames), camera orbited about Y by `orbit` radians.
   Image render(int frame, double orbit = 0.0);
+  // A flock's path in one image: the last of `frames` with the earlier ones, trails and the centre of
+  // mass added (add_flock_path). Throws InputError for a run that is not a flock.
+  Image render_path(const std::vector<int>& frames);
   const RenderSettings& settings() const { return settings_; }
 
  private:

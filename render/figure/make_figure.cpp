@@ -88,7 +88,11 @@ std::filesystem::path make_figure(const FigureRequest& r) {
     FrameRenderer renderer(run, r.backend, {r.width, r.height, r.spp});
     const std::vector<int> frames = resolve_frames(run, r.frames);
     std::vector<Image> images;
-    for (int f : frames) images.push_back(renderer.render(f));
+    if (r.overlay && run.scene.flock) {
+      images.push_back(renderer.render_path(frames));
+    } else {
+      for (int f : frames) images.push_back(renderer.render(f));
+    }
     if (r.overlay) {
       tiles[k].push_back(overlay_frames(images));
       captions[k].push_back("Frames " + std::to_string(frames.front()) + "\u2013" + std::to_string(frames.back()));

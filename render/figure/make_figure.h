@@ -25,7 +25,8 @@ struct FigureRequest {
   std::string backend = "osmesa";
   int width = 400, height = 300;                // one tile, pixels
   int spp = 0;                                  // 0: back end default
-  bool overlay = false;                         // one superimposed tile per run instead of a strip
+  bool overlay = false;                         // one tile per run instead of a strip: a flock's path
+                                                // (add_flock_path), other runs' frames superimposed
 };
 
 // Writes out_dir/NAME.png and, with the same layout and vector type, out_dir/NAME.pdf. Throws InputError

@@ -424,4 +424,41 @@ void build_frame_geometry(const Scene& scene, const Trajectory& traj, int frame,
     for (int k = 0; k < int(meshes->meshes.size()); ++k) add_body_mesh(*meshes, frame, k, scene.render.body_color, out.objects);
 }
 
+void add_flock_path(const Scene& scene, const Trajectory& traj, const std::vector<int>& snapshots,
+                    FrameGeometry& g) {
+  const RenderSpec& rs = scene.render;
+  const int p = traj.particles, frames = traj.frames();
+  const double len = rs.agent_size, line = 0.12 * len, lift = 0.003 * g.scale;
+  const Vec3 n = Vec3::UnitY();
+  auto on_ground = [&](const Vec3& x) { return Vec3(x.x(), g.plane.offset + lift, x.z()); };
+  // Earlier snapshots: the agents again, paler the older they are (the last one is drawn already).
+  for (size_t k = 0; k + 1 < snapshots.size(); ++k) {
+    const double fade = 0.7 - 0.45 * double(k) / double(std::max<size_t>(snapshots.size() - 1, 1));
+    for (int i = 0; i < p; ++i)
+      add_agent(g.objects, on_ground(seg(traj.x[snapshots[k]], i)), heading_of(traj, snapshots[k], i), len,
+                mix(rs.agent_color, rs.ground_color, fade));
+  }
+  // Trails of a few agents spread across the flock, fading from pale (start) to the agent colour.
+  std::vector<int> order(static_cast<size_t>(p));
+  for (int i = 0; i < p; ++i) order[size_t(i)] = i;
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return traj.x[0][3 * a] < traj.x[0][3 * b]; });
+  const int trails = std::min(p, 6);
+  for (int t = 0; t < trails; ++t) {
+    const int i = order[size_t(t * (p - 1) / std::max(trails - 1, 1))];
+    for (int f = 0; f + 1 < frames; ++f) {
+      const double age = 1.0 - double(f) / double(std::max(frames - 2, 1));
+      add_ribbon(g.marks, {on_ground(seg(traj.x[f], i)), on_ground(seg(traj.x[f + 1], i))}, false, line, n,
+                 mix(rs.highlight_color, rs.ground_color, 0.7 * age));
+    }
+  }
+  // The flock's centre of mass, frame by frame: the path it actually took, over the keyframed one.
+  std::vector<Vec3> centre;
+  for (int f = 0; f < frames; ++f) {
+    Vec3 c = Vec3::Zero();
+    for (int i = 0; i < p; ++i) c += seg(traj.x[f], i);
+    centre.push_back(on_ground(c / std::max(p, 1)) + n * lift);
+  }
+  add_ribbon(g.marks, centre, false, 1.5 * line, n, mix(rs.agent_color, Vec3::Zero(), 0.3));
+}
+
 }  // namespace kf::render

@@ -53,4 +53,11 @@ void add_body_mesh(const MeshSequence& seq, int frame, int mesh, const Vec3& col
 void build_frame_geometry(const Scene& scene, const Trajectory& traj, int frame, const Bounds& bounds,
                           FrameGeometry& out, const MeshSequence* meshes = nullptr);
 
+// A flock's path in one picture (paper fig. 3), added to a frame built by build_frame_geometry for the
+// last of `snapshots`: the agents at the earlier snapshots, paler the older; the trails of six agents
+// spread across the flock, fading towards the start; the centre of mass frame by frame as a dark line
+// beside the keyframed path (drawn by the frame already, with its keyframe markers).
+void add_flock_path(const Scene& scene, const Trajectory& traj, const std::vector<int>& snapshots,
+                    FrameGeometry& g);
+
 }  // namespace kf::render

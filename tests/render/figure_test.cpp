@@ -5,6 +5,7 @@
 #include "core/error.h"
 #include "render/figure/figure_sheet.h"
 #include "render/figure/make_figure.h"
+#include "render/frame_renderer.h"
 #include "render/image/png_io.h"
 #include "synthetic_runs.h"
 
@@ -93,6 +94,27 @@ TEST(Figure, ColumnsPutRunsSideBySideAtTheirLastKeyframe) {
   const Image two_rows = read_png(make_figure(r));
   EXPECT_EQ(two_rows.width, one_row.width);
   EXPECT_GT(two_rows.height, one_row.height + 60);
+}
+
+// The path view of a flock (fig. 3): the last frame plus earlier snapshots, red trails and the centre of
+// mass. Against the plain last frame it adds reddish trail pixels and more agent pixels.
+TEST(Figure, FlockPathAddsTrailsSnapshotsAndTheCentreOfMass) {
+  testing::TempDir tmp;
+  const RunData run = load_run(testing::make_flock_run(tmp.path() / "flock"));
+  FrameRenderer renderer(run, "osmesa", {160, 120, 0});
+  const Image plain = renderer.render(5), path = renderer.render_path({0, 3, 5});
+  auto count = [](const Image& img, auto pred) {
+    int n = 0;
+    for (size_t i = 0; i + 2 < img.pixels.size(); i += 3) n += pred(img.pixels[i], img.pixels[i + 1], img.pixels[i + 2]);
+    return n;
+  };
+  auto reddish = [](int r, int g, int b) { return r > g + 40 && r > b + 40; };
+  auto dark = [](int r, int g, int b) { return r + g + b < 3 * 110; };
+  EXPECT_GT(count(path, reddish), count(plain, reddish) + 20);  // the trails (the plain frame's orange path counts too)
+  EXPECT_GT(count(path, dark), count(plain, dark));
+  const RunData cloth = load_run(testing::make_cloth_run(tmp.path() / "cloth", 8));
+  FrameRenderer cloth_renderer(cloth, "osmesa", {160, 120, 0});
+  EXPECT_THROW(cloth_renderer.render_path({0, 5}), InputError);
 }
 
 }  // namespace kf::render
