@@ -10,9 +10,9 @@ namespace kf::render {
 constexpr int kLastKeyframe = -1;  // the run's last keyframe (its last frame if it has none)
 constexpr int kLastFrame = -2;     // the run's last frame
 
-// Paper-style sheets: fig. 1 = runs side by side at their last keyframe
-// (`--layout columns --frames key`), fig. 2/4/5 = strips over time (rows), fig. 3 = `--overlay`,
-// fig. 6 = three runs as columns, time going down (`--layout columns --frames 0,40,80,120`).
+// Paper-style sheets: fig. 1 = runs side by side at their last keyframe (`--columns --frames key`),
+// fig. 2/4/5 = strips over time (rows), fig. 3 = `--overlay`, fig. 6 = three runs as columns, time going
+// down (`--columns --frames 0,15,last`).
 struct FigureRequest {
   std::vector<std::filesystem::path> run_dirs;  // one row each (one column each with `columns`)
   std::vector<int> frames;                      // empty: frame 0, every keyframe, the last frame (at most 6);

@@ -26,10 +26,14 @@ void add_figure_command(CLI::App& app) {
   sub->add_option("--size", *size, "tile size WxH in pixels (default 400x300)");
   sub->add_option("--spp", req->spp, "samples per pixel (default: back end default)");
   sub->add_flag("--overlay", req->overlay, "one tile per run: a flock's path (its agents at these frames, trails of a few agents, the centre of mass), other runs' frames superimposed");
-  sub->footer("Paper layouts: fig. 1  keyframe figure out/square out/cross out/arch --columns --frames key\n"
-              "               fig. 2  keyframe figure out/race   (a strip over time)\n"
-              "               fig. 3  keyframe figure out/path --overlay --frames 0,60,120\n"
-              "               fig. 6  keyframe figure out/capeA out/blend out/capeB --columns --frames 0,40,80");
+  sub->footer("Paper layouts, after keyframe run scenes/NAME.json for each run named (scripts/readme-figures makes\n"
+              "them all with Embree):\n"
+              "  fig. 1  keyframe figure out/square out/cross out/arch --columns --frames key\n"
+              "  fig. 2  keyframe figure out/race                      (a strip over time)\n"
+              "  fig. 3  keyframe figure out/path --overlay --frames 0,60,120\n"
+              "  fig. 4  keyframe figure out/shapes\n"
+              "  fig. 5  keyframe figure out/ring-toss --frames 0,6,12,18,24\n"
+              "  fig. 6  keyframe figure out/cape-a out/cape-blend out/cape-b --columns --frames 0,15,last");
   sub->callback([=] {
     render::FigureRequest r = *req;
     if (!frames->empty()) {
