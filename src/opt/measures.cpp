@@ -173,6 +173,20 @@ void arch_measures(const Scene& scene, const ArchKeyframe& k, const Trajectory& 
   m["rms_over_width"] = width > 0 ? std::sqrt(sum / p) / width : 0.0;
 }
 
+// How far a free sheet turned over: the angle of its normal (from the corner diagonals) from frame 0's.
+nlohmann::json sheet_measures(const ClothSpec& cloth, const Trajectory& t) {
+  const int a = 0, b = cloth.nx - 1, c = (cloth.ny - 1) * cloth.nx, d = cloth.nx * cloth.ny - 1;
+  auto normal = [&](const VecX& x) {
+    const Vec3 n = (seg(x, d) - seg(x, a)).cross(seg(x, c) - seg(x, b));
+    return n.norm() > 0 ? Vec3(n.normalized()) : Vec3::UnitY();
+  };
+  const Vec3 n0 = normal(t.x[0]);
+  auto degrees = [&](const VecX& x) { return std::acos(std::clamp(n0.dot(normal(x)), -1.0, 1.0)) * 180.0 / M_PI; };
+  double most = 0;
+  for (int f = 0; f < t.frames(); ++f) most = std::max(most, degrees(t.x[size_t(f)]));
+  return {{"type", "sheet"}, {"flip_degrees", most}, {"flip_degrees_at_end", degrees(t.x.back())}};
+}
+
 }  // namespace
 
 nlohmann::json figure_measures(const Scene& scene, const Trajectory& t) {
@@ -199,6 +213,7 @@ nlohmann::json figure_measures(const Scene& scene, const Trajectory& t) {
   visit_system(scene, Overloaded{
                           [](const FlockSpec&) {},
                           [&](const ClothSpec& cloth) {
+                            if (cloth.pins.empty()) out.push_back(sheet_measures(cloth, t));
                             for (size_t k = 0; k < cloth.colliders.size(); ++k)
                               if (const auto* torus = std::get_if<TorusShape>(&cloth.colliders[k].shape)) {
                                 nlohmann::json m = ring_measures(*torus, t);
@@ -271,7 +286,7 @@ nlohmann::json ring_measures(const TorusShape& torus, const Trajectory& t) {
   nlohmann::json m = {{"type", "ring"}};
   m["crossings"] = crossings;
   m["inner_radius"] = inner;
-  m["center_of_mass_through_ring"] = crossings > 0 && min_axis < inner;
+  m["through_ring"] = crossings > 0 && min_axis < inner;
   m["min_distance_to_ring_axis_when_crossing"] = crossings > 0 ? nlohmann::json(min_axis) : nlohmann::json();
   m["min_signed_distance"] = min_phi;
   m["penetration_free"] = min_phi >= 0;

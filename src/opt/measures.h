@@ -8,18 +8,22 @@
 namespace kf {
 
 // One JSON object per objective of the scene, in order, with "type", "frame" and its measures:
-//  shape: inside_fraction, min_spacing, median_spacing (nearest-neighbour distances, metres);
+//  shape: inside_fraction, coverage_fraction, coverage_radius, min_spacing, median_spacing (nearest-neighbour
+//    distances, metres);
 //  center_of_mass: error, path_length, error_over_path;
 //  position on one agent of a flock (the race): rank_at_start, rank_at_end along the heading
-//    (0 = last, agents-1 = first), last_at_start, first_at_end;
+//    (0 = last, agents-1 = first), last_at_start, first_at_end, racer_rank (1 = first), racer_lead,
+//    racer_within_front, flock_groups_max, flock_connected;
 //  position/velocity otherwise: rms_error (metres, m/s; cloth also rms_over_width: over the sheet's width
 //    at frame 0);  arch: rms_distance, width, rms_over_width.
 // Then, for a cloth, one object per torus collider ("type": "ring", "collider": its index) over all frames:
-//  center_of_mass_through_ring (the centre of mass crosses the ring's plane inside the tube's inner circle),
+//  through_ring (the centre of mass crosses the ring's plane inside the tube's inner circle),
 //  crossings (plane crossings of the centre of mass), min_distance_to_ring_axis_when_crossing (metres, null
 //  without a crossing), inner_radius (metres), min_signed_distance (to the torus surface over all particles
 //  and frames, metres; negative is penetration), penetration_free. Frames only: a contact between frames
-//  is not seen.
+//  is not seen. And one "sheet" object for a cloth without pins: flip_degrees (the largest angle between
+//  the sheet's normal, from its corner diagonals, and its normal at frame 0, over all frames) and
+//  flip_degrees_at_end.
 nlohmann::json figure_measures(const Scene& scene, const Trajectory& frames);
 
 // The cape blend's end state (scenes with a character and an end target): for the run and for the

@@ -113,13 +113,35 @@ TEST(ClothFigures, RingTossPassesThroughTheRingWithoutPenetrating) {
     "optimizer": {"max_evaluations": 40, "ftol_rel": 1e-10}})",
                                   "ring-toss-small.json");
   const Outcome o = optimise(scene);
-  ASSERT_EQ(o.measures.size(), 2u);
-  const json& ring = o.measures.at(1);
+  ASSERT_EQ(o.measures.size(), 3u);  // the keyframe, the sheet, the ring
+  EXPECT_LT(o.measures.at(1).at("flip_degrees").get<double>(), 45.0);  // thrown, not turned over
+  const json& ring = o.measures.at(2);
   ASSERT_EQ(ring.at("type"), "ring");
-  EXPECT_TRUE(ring.at("center_of_mass_through_ring").get<bool>()) << ring.dump();
+  EXPECT_TRUE(ring.at("through_ring").get<bool>()) << ring.dump();
   EXPECT_LT(ring.at("min_distance_to_ring_axis_when_crossing").get<double>(), 0.05) << ring.dump();
   EXPECT_GE(ring.at("min_signed_distance").get<double>(), 0.0) << ring.dump();
   EXPECT_LT(o.measures.at(0).at("error").get<double>(), 0.01);
+}
+
+TEST(ClothFigures, SheetMeasureSeesAHalfTurn) {
+  // A free 2x2 sheet in the x-z plane, rolled about x by 0, 90, 180 and then 120 degrees.
+  const Scene scene = parse_scene(R"({"time": {"frames": 3}, "cloth": {"nx": 2, "ny": 2, "width": 1, "height": 1,
+    "u_axis": [1, 0, 0], "v_axis": [0, 0, 1]}})", "sheet.json");
+  Trajectory t;
+  t.particles = 4;
+  for (double deg : {0.0, 90.0, 180.0, 120.0}) {
+    const double a = deg * M_PI / 180;
+    VecX x(12), v = VecX::Zero(12);
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) seg(x, 2 * j + i) = Vec3(i, -j * std::sin(a), j * std::cos(a));
+    t.x.push_back(x);
+    t.v.push_back(v);
+  }
+  const json m = figure_measures(scene, t);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_EQ(m[0].at("type"), "sheet");
+  EXPECT_NEAR(m[0].at("flip_degrees").get<double>(), 180.0, 1e-9);
+  EXPECT_NEAR(m[0].at("flip_degrees_at_end").get<double>(), 120.0, 1e-9);
 }
 
 TEST(ClothFigures, RingMeasuresSeeAMissAndAPenetration) {
@@ -134,13 +156,13 @@ TEST(ClothFigures, RingMeasuresSeeAMissAndAPenetration) {
   t.v = t.x;
   json m = ring_measures(torus, t);
   EXPECT_EQ(m.at("crossings"), 1);
-  EXPECT_FALSE(m.at("center_of_mass_through_ring").get<bool>());
+  EXPECT_FALSE(m.at("through_ring").get<bool>());
   EXPECT_NEAR(m.at("min_distance_to_ring_axis_when_crossing").get<double>(), 0.3, 1e-12);
   EXPECT_LT(m.at("min_signed_distance").get<double>(), 0.0);
   EXPECT_FALSE(m.at("penetration_free").get<bool>());
   t.x = {Vec3(-0.01, 0.05, 0), Vec3(0.01, 0.05, 0)};
   m = ring_measures(torus, t);
-  EXPECT_TRUE(m.at("center_of_mass_through_ring").get<bool>());
+  EXPECT_TRUE(m.at("through_ring").get<bool>());
   EXPECT_TRUE(m.at("penetration_free").get<bool>());
 }
 
