@@ -38,6 +38,7 @@ nlohmann::json bench_cloth(const ClothSweepOptions& o, const std::filesystem::pa
   BenchPointOptions po;
   po.gradcheck_samples = o.gradcheck_samples;
   po.optimize_evaluations = o.optimize_evaluations;
+  po.repeats = 3;  // the fastest of three: single runs of these short sweeps vary by 2x on a shared machine
   nlohmann::json summary;
   auto run = [&](const std::string& name, const std::string& x_name, const std::vector<double>& xs,
                  const std::function<Scene(double)>& make, bool log_x) {
