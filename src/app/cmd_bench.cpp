@@ -1,5 +1,6 @@
 // keyframe bench: sweep speed against error (cloth), cost against size (flock), memory against steps.
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
@@ -60,7 +61,16 @@ void add_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
   auto* s = sub->add_option_group("solver sweep");
   s->add_option("--solver-resolutions", o->solver.resolutions, "n for n x n sheets")
       ->capture_default_str()->delimiter(',')->check(CLI::Range(2, 1024));
-  s->add_option("--solvers", o->solver.solvers, "pcg (1e-8), pcg-TOL, direct")->capture_default_str()->delimiter(',');
+  s->add_option("--solvers", o->solver.solvers, "pcg (1e-8), pcg-TOL, direct")
+      ->capture_default_str()
+      ->delimiter(',')
+      ->check([](const std::string& v) -> std::string {
+        if (v == "pcg" || v == "direct") return "";
+        char* end = nullptr;
+        const double tol = v.rfind("pcg-", 0) == 0 ? std::strtod(v.c_str() + 4, &end) : 0;
+        if (end && *end == 0 && tol > 0 && tol < 1) return "";
+        return "expected pcg, pcg-TOL (0 < TOL < 1) or direct, got " + v;
+      });
   s->add_option("--threads", o->solver.threads, "thread counts")
       ->capture_default_str()->delimiter(',')->check(CLI::Range(1, 256));
   s->add_option("--solver-frames", o->solver.frames, "frames of the 50 x 50 sheet (fewer on bigger ones)")
