@@ -16,6 +16,17 @@ struct ClothSweepOptions {
   int gradcheck_samples = 24, optimize_evaluations = 30;
 };
 
+struct SolverSweepOptions {
+  std::vector<int> resolutions{16, 32, 50, 64, 100, 128};  // n for an n x n sheet
+  std::vector<std::string> solvers{"pcg", "pcg-1e-5", "direct"};  // PCG at 1e-8 / 1e-5, sparse Cholesky
+  std::vector<int> threads{1, 2};
+  int frames = 4;      // frames of the 50 x 50 sheet (10 steps each); bigger sheets run proportionally fewer
+  int repeats = 2;     // timings are the fastest of this many runs
+  int direct_max_n = 64;  // the direct solver only up to this n
+  int blender_n = 50;  // side-by-side sheet (0: none)
+  std::filesystem::path blender_script = "../shared/anchors/blender/bench.py";
+};
+
 struct FlockSweepOptions {
   std::vector<int> agents{100, 300, 1000, 3000, 10000};
   int frames = 30, optimize_evaluations = 10;
@@ -41,6 +52,10 @@ nlohmann::json bench_adjoint(const AdjointSweepOptions& o, const std::filesystem
 
 // Cloth: time step, resolution, PCG tolerance, per-step vs per-frame control.
 nlohmann::json bench_cloth(const ClothSweepOptions& o, const std::filesystem::path& out);
+// Solver: the pinned sheet's cost per step against particles for each solver and thread count, forward and
+// gradient (solver.csv, solver_*.png); with blender installed, the 120-frame 50 x 50 bake beside ours
+// (solver_blender.csv).
+nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::path& out);
 // Flock: agents against time per gradient and per short optimisation, with fitted exponents.
 nlohmann::json bench_flock(const FlockSweepOptions& o, const std::filesystem::path& out);
 // Peak resident memory of one cloth gradient against steps, with and without checkpointing; each

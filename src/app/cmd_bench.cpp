@@ -1,5 +1,6 @@
 // keyframe bench: sweep speed against error (cloth), cost against size (flock), memory against steps.
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
@@ -19,6 +20,7 @@ struct BenchOptions {
   ClothSweepOptions cloth;
   FlockSweepOptions flock;
   MemorySweepOptions memory;
+  SolverSweepOptions solver;
   AdjointSweepOptions adjoint;
   int point_steps = 0, point_every = 0, point_resolution = 16;
 };
@@ -56,6 +58,28 @@ void add_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
       ->capture_default_str()->check(CLI::Range(1, 10000000));
   m->add_option("--memory-resolution", o->memory.resolution, "n of the n x n cloth")
       ->capture_default_str()->check(CLI::Range(2, 1024));
+  auto* s = sub->add_option_group("solver sweep");
+  s->add_option("--solver-resolutions", o->solver.resolutions, "n for n x n sheets")
+      ->capture_default_str()->delimiter(',')->check(CLI::Range(2, 1024));
+  s->add_option("--solvers", o->solver.solvers, "pcg (1e-8), pcg-TOL, direct")
+      ->capture_default_str()
+      ->delimiter(',')
+      ->check([](const std::string& v) -> std::string {
+        if (v == "pcg" || v == "direct") return "";
+        char* end = nullptr;
+        const double tol = v.rfind("pcg-", 0) == 0 ? std::strtod(v.c_str() + 4, &end) : 0;
+        if (end && *end == 0 && tol > 0 && tol < 1) return "";
+        return "expected pcg, pcg-TOL (0 < TOL < 1) or direct, got " + v;
+      });
+  s->add_option("--threads", o->solver.threads, "thread counts")
+      ->capture_default_str()->delimiter(',')->check(CLI::Range(1, 256));
+  s->add_option("--solver-frames", o->solver.frames, "frames of the 50 x 50 sheet (fewer on bigger ones)")
+      ->capture_default_str()->check(CLI::Range(1, 100000));
+  s->add_option("--direct-max-n", o->solver.direct_max_n, "largest n the direct solver runs at")
+      ->capture_default_str()->check(CLI::Range(0, 1024));
+  s->add_option("--blender-n", o->solver.blender_n, "sheet of the Blender side-by-side (0: none)")
+      ->capture_default_str()->check(CLI::Range(0, 1024));
+  s->add_option("--blender-script", o->solver.blender_script, "the anchor's Blender script")->capture_default_str();
   auto* a = sub->add_option_group("adjoint sweep");
   a->add_option("--adjoint-scenes", o->adjoint.scenes, "cloth scenes (names in --scene-dir) compared exact vs swap")
       ->capture_default_str()->delimiter(',');
@@ -81,6 +105,7 @@ void apply_quick_defaults(CLI::App* sub, BenchOptions& o) {
   if (!given("--steps")) o.memory.steps = {500, 1000, 2000, 4000};
   if (!given("--adjoint-frames")) o.adjoint.frames = 6;
   if (!given("--adjoint-seconds")) o.adjoint.optimize_seconds = 10;
+  if (!given("--solver-resolutions")) o.solver.resolutions = {16, 32, 50};
 }
 
 }  // namespace
@@ -91,14 +116,15 @@ void add_bench_command(CLI::App& app) {
       "sweep speed against error: cloth (time step, resolution, PCG tolerance, per-step vs per-frame control), "
       "flock (agents, fitted scaling exponent), memory (peak RSS against steps with and without adjoint "
       "checkpointing), adjoint (exact against swap on the cloth figures: gradient cost and error, keyframe error "
-      "in the same wall time); writes CSV + PNG under --out");
+      "in the same wall time), solver (cloth step cost against particles per linear solver and thread count, "
+      "forward and gradient, beside Blender when installed); writes CSV + PNG under --out");
   auto o = std::make_shared<BenchOptions>();
   sub->add_option("--out", o->out, "output directory")->capture_default_str();
   sub->add_flag("--quick", o->quick,
                 "reduced sweep (a few minutes): substeps 1,4,16; n 16,24,32; tolerances 1e-4,1e-6,1e-8; agents "
                 "100,300,1000; steps 500..4000; fewer samples and evaluations. Options given explicitly win.");
   sub->add_option("--only", o->only, "run only these sweeps")
-      ->check(CLI::IsMember({"cloth", "flock", "memory", "adjoint"}))
+      ->check(CLI::IsMember({"cloth", "flock", "memory", "adjoint", "solver"}))
       ->delimiter(',');
   add_sweep_options(sub, o);
   // The child side of the memory sweep: one gradient in a fresh process.
@@ -121,6 +147,7 @@ void add_bench_command(CLI::App& app) {
     if (want("flock")) summary["flock"] = bench_flock(o->flock, out);
     if (want("cloth")) summary["cloth"] = bench_cloth(o->cloth, out);
     if (want("adjoint")) summary["adjoint"] = bench_adjoint(o->adjoint, out);
+    if (want("solver")) summary["solver"] = bench_solver(o->solver, out);
     write_file_atomic(out / "summary.json", summary.dump(2) + "\n");
   });
 }

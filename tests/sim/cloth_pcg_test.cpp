@@ -4,6 +4,7 @@
 
 #include "scene/scene.h"
 #include "sim/cloth/cloth_system.h"
+#include "sim/cloth/direct_solve.h"
 
 namespace kf {
 namespace {
@@ -91,6 +92,31 @@ TEST_F(ClothPcg, IndefinitePivotFallsBackToBlockJacobi) {
   pcg.resize(B.block_rows(), Preconditioner::kIncompleteCholesky);
   pcg.prepare(B, free);
   EXPECT_FALSE(pcg.incomplete_cholesky());
+}
+
+// The sparse direct solve (pattern analysed once, values refreshed each factor) on the same matrix: A x = b
+// on the free rows to round-off, pins kept, and a second factor of changed values solves the new system.
+TEST_F(ClothPcg, DirectSolveIsExactAndReusesItsAnalysis) {
+  FilteredDirect direct;
+  for (int round = 0; round < 2; ++round) {
+    if (round == 1)  // new values on the same pattern: the mass term doubled
+      for (int i = 0; i < B.block_rows(); ++i) {
+        B.block(B.diag_slot(i)) += B.block(B.diag_slot(i)).diagonal().asDiagonal();
+        for (int a = 0; a < 3; ++a) A.coeffRef(3 * i + a, 3 * i + a) *= 2;
+      }
+    ASSERT_TRUE(direct.factor(B, free)) << FilteredDirect::backend();
+    VecX x = VecX::Zero(b.size());
+    for (int i = 0; i < B.block_rows(); ++i)
+      if (!free[i]) seg(x, i) = Vec3(1, 2, 3);
+    ASSERT_TRUE(direct.solve(B, free, b, x));
+    const VecX r = b - A * x;
+    for (int i = 0; i < B.block_rows(); ++i) {
+      if (free[i]) EXPECT_LT(seg(r, i).norm(), 1e-12 * b.norm()) << "round " << round << ", particle " << i;
+      else EXPECT_EQ(seg(x, i), Vec3(1, 2, 3));
+    }
+    const Solve ic = solve(Preconditioner::kIncompleteCholesky);
+    EXPECT_LT((ic.x - x).norm(), 1e-7 * x.norm()) << "round " << round;
+  }
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "sim/cloth/cloth_system.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -97,6 +98,7 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
     if (!free_[i]) pinned_list_.push_back(i);
 
   spring_f_.assign(springs_.size(), Vec3::Zero());
+  energy_parts_.assign((springs_.size() + kSpringGrain - 1) / kSpringGrain, 0.0);
   spring_K_.assign(springs_.size(), Mat3::Zero());
   spring_D_.assign(springs_.size(), Mat3::Zero());
   force_.setZero(3 * p_);
@@ -231,7 +233,17 @@ ClothSystem::Energy ClothSystem::energy(int n, const VecX& x, const VecX& v) con
     e.kinetic += 0.5 * mass_[i] * seg(v, i).squaredNorm();
     e.gravity -= mass_[i] * spec_.gravity.dot(seg(x, i));
   }
-  for (const BucklingSpring& s : springs_) e.elastic += spring_energy(s, x);
+  // Springs in fixed chunks summed in chunk order: the same sum on any thread count.
+  const int ns = int(springs_.size()), chunks = (ns + kSpringGrain - 1) / kSpringGrain;
+  double* parts = energy_parts_.data();  // sized for every chunk at construction
+  tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), [&](const tbb::blocked_range<int>& r) {
+    for (int c = r.begin(); c < r.end(); ++c) {
+      double sum = 0;
+      for (int k = c * kSpringGrain; k < std::min(ns, (c + 1) * kSpringGrain); ++k) sum += spring_energy(springs_[k], x);
+      parts[c] = sum;
+    }
+  });
+  for (int c = 0; c < chunks; ++c) e.elastic += parts[c];
   return e;
 }
 
@@ -404,7 +416,7 @@ std::string ClothSystem::describe() const {
   std::ostringstream os;
   os << "cloth: " << spec_.nx << "x" << spec_.ny << " particles, " << springs_.size() << " springs, "
      << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, "
-     << (direct_solve_ ? "sparse LDL^T" : "PCG (" + spec_.cg_preconditioner + ")") << ", " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
+     << (direct_solve_ ? std::string("sparse ") + FilteredDirect::backend() : "PCG (" + spec_.cg_preconditioner + ")") << ", " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
   return os.str();
 }
 

@@ -148,6 +148,7 @@ class ClothSystem final : public System {
   // Per-step work space, sized once.
   std::vector<Vec3> spring_f_;
   std::vector<Mat3> spring_K_, spring_D_;
+  mutable std::vector<double> energy_parts_;  // energy(): one partial sum per fixed chunk of springs
   std::vector<Mat3> contact_K_;  // per particle: the colliders' part of K's diagonal block
   BlockSparse3 K_, D_, A_;
   VecX force_, rhs_, dv_, aw_;

@@ -1,0 +1,144 @@
+// Solver sweep: the cloth step's cost against particles for each linear solver, on 1 and 2 threads,
+// forward and gradient; and the pinned 50 x 50 sheet beside Blender's bake when `blender` is installed.
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <tbb/global_control.h>
+
+#include "adjoint/rollout.h"
+#include "app/bench_point.h"
+#include "app/bench_sweeps.h"
+#include "app/plot.h"
+#include "sim/make_system.h"
+
+namespace kf {
+
+namespace {
+
+// The Blender anchor's sheet: 1 m^2, horizontal, one edge pinned, swinging down under gravity; fps 24 and
+// 10 steps a frame. `solver`: "pcg" (IC(0) PCG at the scene default 1e-8), "pcg-1e-5" (PCG at that
+// tolerance) or "direct". A position keyframe at the last frame gives the gradient something to carry.
+Scene solver_scene(int n, const std::string& solver, int frames) {
+  std::string extra = R"("solver": "direct")";
+  if (solver.rfind("pcg", 0) == 0) {
+    const std::string tol = solver.size() > 4 ? solver.substr(4) : "1e-8";
+    extra = R"("solver": "pcg", "cg_tolerance": )" + tol;
+  }
+  const std::string text = R"({
+    "time": {"fps": 24, "substeps": 10, "frames": )" + std::to_string(frames) + R"(},
+    "cloth": {"nx": )" + std::to_string(n) + R"(, "ny": )" + std::to_string(n) + R"(, "width": 1.0, "height": 1.0,
+              "origin": [-0.5, 1, -0.5], "u_axis": [1, 0, 0], "v_axis": [0, 0, 1], "pins": "bottom_edge", )" + extra + R"(},
+    "objectives": [{"type": "center_of_mass", "frame": )" + std::to_string(frames) + R"(, "target": [0, 0.8, 0], "weight": 10}],
+    "controls": {"kind": "per_frame", "alpha": 0.001}
+  })";
+  return parse_scene(text, "bench_solver_" + std::to_string(n) + ".json");
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// One uncontrolled forward simulation of the scene (s, fastest of `repeats`); -1 when it diverged.
+double forward_seconds(const Scene& scene, int repeats) {
+  double best = 1e300;
+  for (int r = 0; r < repeats; ++r) {
+    auto sys = make_system(scene);
+    VecX x0, v0;
+    sys->initial_state(x0, v0);
+    std::vector<VecX> U(scene.time.steps(), VecX::Zero(sys->dof()));
+    Rollout roll;
+    const auto t0 = std::chrono::steady_clock::now();
+    if (!simulate(*sys, x0, v0, U, roll)) return -1;
+    best = std::min(best, seconds_since(t0));
+  }
+  return best;
+}
+
+// Blender's bake of the same sheet (s), through the anchor script; -1 when blender or the script is missing.
+double blender_seconds(const std::filesystem::path& script, int n, const std::filesystem::path& out) {
+  if (std::system("command -v blender > /dev/null 2>&1") != 0 || !std::filesystem::exists(script)) return -1;
+  const auto csv = out / "blender_raw.csv";
+  std::filesystem::remove(csv);
+  const std::string cmd = "blender -b --factory-startup --python-exit-code 1 --python '" + script.string() +
+                          "' -- --workload cloth --n " + std::to_string(n) + " --csv '" + csv.string() +
+                          "' > '" + (out / "blender.log").string() + "' 2>&1";
+  if (std::system(cmd.c_str()) != 0) return -1;
+  std::ifstream in(csv);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (!line.empty()) last = line;
+  const auto comma = last.rfind(',');
+  return comma == std::string::npos ? -1 : std::atof(last.c_str() + comma + 1);
+}
+
+}  // namespace
+
+nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::path& out) {
+  nlohmann::json summary;
+  std::vector<std::string> cols = {"n", "particles"};
+  for (const auto& s : o.solvers)
+    for (int t : o.threads)
+      for (const char* what : {"forward_ms", "gradient_ms", "gradient_over_forward"})
+        cols.push_back(s + "_t" + std::to_string(t) + "_" + what);
+  CsvTable table(cols);
+  BenchPointOptions po;
+  po.repeats = o.repeats;
+  for (int n : o.resolutions) {
+    std::vector<std::string> row = {std::to_string(n), std::to_string(n * n)};
+    // Fewer frames on big sheets keep every point to seconds; the cost is per step.
+    const int frames = std::max(1, o.frames * 2500 / std::max(2500, n * n));
+    for (const auto& s : o.solvers)
+      for (int t : o.threads) {
+        if (s == "direct" && n > o.direct_max_n) {  // a factor per step: minutes at these sizes
+          for (int c = 0; c < 3; ++c) row.push_back("nan");
+          continue;
+        }
+        tbb::global_control threads(tbb::global_control::max_allowed_parallelism, t);
+        const Scene scene = solver_scene(n, s, frames);
+        std::cerr << "bench solver: n = " << n << ", " << s << ", " << t << " thread(s), " << frames << " frames"
+                  << std::endl;
+        const BenchPoint p = measure_point(scene, po);
+        const double steps = scene.time.steps();
+        const bool ok = !p.diverged;
+        row.push_back(ok ? fmt(1e3 * p.forward_s / steps) : "nan");
+        row.push_back(ok ? fmt(1e3 * p.gradient_s / steps) : "nan");
+        row.push_back(ok ? fmt(p.gradient_s / p.forward_s) : "nan");
+      }
+    table.add(row);
+  }
+  const auto csv = out / "solver.csv";
+  table.write(csv);
+  std::vector<int> fwd, grad;
+  for (const auto& s : o.solvers)
+    for (int t : o.threads) {
+      fwd.push_back(table.col(s + "_t" + std::to_string(t) + "_forward_ms"));
+      grad.push_back(table.col(s + "_t" + std::to_string(t) + "_gradient_ms"));
+    }
+  plot_csv(csv, out / "solver_forward.png", "cloth: forward ms per step against particles", table.col("particles"), fwd,
+           true, true);
+  plot_csv(csv, out / "solver_gradient.png", "cloth: gradient (forward + adjoint) ms per step against particles",
+           table.col("particles"), grad, true, true);
+  summary["solver"] = table.excerpt();
+  std::cout << "solver.csv\n" << table.excerpt() << std::endl;
+
+  // Side by side: the whole 120-frame x 10-step bake of the 50 x 50 sheet, default threads.
+  if (o.blender_n > 0) {
+    CsvTable side({"n", "frames", "steps", "blender_s", "pcg_s", "pcg_1e-5_s", "blender_over_pcg", "blender_over_pcg_1e-5"});
+    const double b = blender_seconds(o.blender_script, o.blender_n, out);
+    const double pcg = forward_seconds(solver_scene(o.blender_n, "pcg", 120), o.repeats);
+    const double loose = forward_seconds(solver_scene(o.blender_n, "pcg-1e-5", 120), o.repeats);
+    if (b < 0) std::cerr << "bench solver: blender or " << o.blender_script << " not found; no side-by-side\n";
+    auto ratio = [&](double ours) { return b > 0 && ours > 0 ? fmt(b / ours) : std::string("nan"); };
+    side.add({std::to_string(o.blender_n), "120", "1200", b > 0 ? fmt(b) : "nan", fmt(pcg), fmt(loose), ratio(pcg),
+              ratio(loose)});
+    side.write(out / "solver_blender.csv");
+    summary["blender"] = side.excerpt();
+    std::cout << "solver_blender.csv\n" << side.excerpt() << std::endl;
+  }
+  return summary;
+}
+
+}  // namespace kf
