@@ -19,13 +19,17 @@ namespace kf {
 namespace {
 
 // The Blender anchor's sheet: 1 m^2, horizontal, one edge pinned, swinging down under gravity; fps 24 and
-// 10 steps a frame. `solver`: "pcg" (IC(0) PCG at the scene default 1e-8), "pcg-1e-5" (PCG at that
-// tolerance) or "direct". A position keyframe at the last frame gives the gradient something to carry.
+// 10 steps a frame. `solver`: "direct", or a PCG preconditioner with an optional tolerance (default the
+// scene default 1e-8): "pcg[-TOL]" (IC(0)), "mg[-TOL]" (multigrid), "auto[-TOL]" (the scene default: IC(0)
+// below 5,000 particles, multigrid from there). A position keyframe at the last frame gives the gradient
+// something to carry.
 Scene solver_scene(int n, const std::string& solver, int frames) {
   std::string extra = R"("solver": "direct")";
-  if (solver.rfind("pcg", 0) == 0) {
-    const std::string tol = solver.size() > 4 ? solver.substr(4) : "1e-8";
-    extra = R"("solver": "pcg", "cg_tolerance": )" + tol;
+  if (solver != "direct") {
+    const auto dash = solver.find('-');
+    const std::string kind = solver.substr(0, dash), tol = dash == std::string::npos ? "1e-8" : solver.substr(dash + 1);
+    const std::string pre = kind == "pcg" ? "incomplete_cholesky" : kind == "mg" ? "multigrid" : "auto";
+    extra = R"("solver": "pcg", "cg_preconditioner": ")" + pre + R"(", "cg_tolerance": )" + tol;
   }
   const std::string text = R"({
     "time": {"fps": 24, "substeps": 10, "frames": )" + std::to_string(frames) + R"(},

@@ -18,7 +18,8 @@ struct ClothSweepOptions {
 
 struct SolverSweepOptions {
   std::vector<int> resolutions{16, 32, 50, 64, 100, 128};  // n for an n x n sheet
-  std::vector<std::string> solvers{"pcg", "pcg-1e-5", "direct"};  // PCG at 1e-8 / 1e-5, sparse Cholesky
+  // IC(0) PCG at 1e-8 / 1e-5, multigrid PCG at 1e-8, the scene default, sparse Cholesky
+  std::vector<std::string> solvers{"pcg", "pcg-1e-5", "mg", "auto", "direct"};
   std::vector<int> threads{1, 2};
   int frames = 4;      // frames of the 50 x 50 sheet (10 steps each); bigger sheets run proportionally fewer
   int repeats = 2;     // timings are the fastest of this many runs

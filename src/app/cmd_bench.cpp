@@ -61,15 +61,19 @@ void add_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
   auto* s = sub->add_option_group("solver sweep");
   s->add_option("--solver-resolutions", o->solver.resolutions, "n for n x n sheets")
       ->capture_default_str()->delimiter(',')->check(CLI::Range(2, 1024));
-  s->add_option("--solvers", o->solver.solvers, "pcg (1e-8), pcg-TOL, direct")
+  s->add_option("--solvers", o->solver.solvers,
+                "pcg[-TOL] (IC(0) PCG), mg[-TOL] (multigrid PCG), auto[-TOL] (the scene default), direct; TOL "
+                "defaults to 1e-8")
       ->capture_default_str()
       ->delimiter(',')
       ->check([](const std::string& v) -> std::string {
-        if (v == "pcg" || v == "direct") return "";
+        if (v == "pcg" || v == "mg" || v == "auto" || v == "direct") return "";
+        const auto dash = v.find('-');
+        const std::string kind = v.substr(0, dash == std::string::npos ? 0 : dash);
         char* end = nullptr;
-        const double tol = v.rfind("pcg-", 0) == 0 ? std::strtod(v.c_str() + 4, &end) : 0;
+        const double tol = kind == "pcg" || kind == "mg" || kind == "auto" ? std::strtod(v.c_str() + dash + 1, &end) : 0;
         if (end && *end == 0 && tol > 0 && tol < 1) return "";
-        return "expected pcg, pcg-TOL (0 < TOL < 1) or direct, got " + v;
+        return "expected pcg, mg, auto (each optionally -TOL, 0 < TOL < 1) or direct, got " + v;
       });
   s->add_option("--threads", o->solver.threads, "thread counts")
       ->capture_default_str()->delimiter(',')->check(CLI::Range(1, 256));

@@ -134,7 +134,7 @@ ClothSpec parse_cloth_spec(Block& b) {
   s.velocity = b.vec3("velocity", s.velocity, -1e4, 1e4);
   s.cg_tolerance = b.number("cg_tolerance", s.cg_tolerance, 1e-16, 1e-1);
   s.cg_max_iterations = b.integer("cg_max_iterations", s.cg_max_iterations, 1, 1'000'000);
-  s.cg_preconditioner = b.string("cg_preconditioner", s.cg_preconditioner, {"incomplete_cholesky", "block_jacobi"});
+  s.cg_preconditioner = b.string("cg_preconditioner", s.cg_preconditioner, {"auto", "incomplete_cholesky", "multigrid", "block_jacobi"});
   s.solver = b.string("solver", s.solver, {"pcg", "direct"});
   s.max_halvings = b.integer("max_halvings", s.max_halvings, 0, 16);
   s.contact_ramp = b.number("contact_ramp", s.contact_ramp, 0.0, 1.0);

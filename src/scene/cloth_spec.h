@@ -75,7 +75,9 @@ struct ClothSpec {
   Vec3 velocity = Vec3::Zero();         // initial velocity of every free particle, m/s
   double cg_tolerance = 1e-8;           // PCG stops when |r| <= cg_tolerance * |b| (filtered)
   int cg_max_iterations = 1000;         // PCG failing to converge within this fails the step
-  std::string cg_preconditioner = "incomplete_cholesky";  // or "block_jacobi"
+  // "auto" (IC(0) below 5,000 particles, multigrid from there), "incomplete_cholesky", "multigrid",
+  // "block_jacobi".
+  std::string cg_preconditioner = "auto";
   std::string solver = "pcg";           // "direct": sparse LDL^T per step, exact to round-off
   // A step that gains energy is split in halves, at most this many times (0: never split).
   int max_halvings = 8;

@@ -34,12 +34,6 @@ int BlockSparse3::find(int i, int j) const {
   return (it != e && *it == j) ? int(it - col_.begin()) : -1;
 }
 
-Vec3 BlockSparse3::row_times(int i, const VecX& x) const {
-  Vec3 y = Vec3::Zero();
-  for (int k = row_start_[i]; k < row_start_[i + 1]; ++k) y.noalias() += val_[k] * seg(x, col_[k]);
-  return y;
-}
-
 void BlockSparse3::multiply(const VecX& x, VecX& y) const {
   constexpr int kGrain = 256;
   if (block_rows() <= kGrain) {  // a task costs more than a small product

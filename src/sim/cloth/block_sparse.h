@@ -26,8 +26,21 @@ class BlockSparse3 {
   Mat3& block(int slot) { return val_[slot]; }
   const Mat3& block(int slot) const { return val_[slot]; }
 
-  // Row i of (this * x): x has 3 * block_rows() entries.
-  Vec3 row_times(int i, const VecX& x) const;
+  // Row i of (this * x): x has 3 * block_rows() entries. Inline and in scalars: every solver's inner
+  // loop is this product, and the compiler keeps the three sums in registers.
+  Vec3 row_times(int i, const VecX& x) const {
+    double y0 = 0, y1 = 0, y2 = 0;
+    const double* xd = x.data();
+    for (int k = row_start_[i]; k < row_start_[i + 1]; ++k) {
+      const double* a = val_[k].data();  // column-major
+      const double* xv = xd + 3 * col_[k];
+      const double x0 = xv[0], x1 = xv[1], x2 = xv[2];
+      y0 += a[0] * x0 + a[3] * x1 + a[6] * x2;
+      y1 += a[1] * x0 + a[4] * x1 + a[7] * x2;
+      y2 += a[2] * x0 + a[5] * x1 + a[8] * x2;
+    }
+    return Vec3(y0, y1, y2);
+  }
   // y = this * x (both 3 * block_rows()); y must already have the right size.
   void multiply(const VecX& x, VecX& y) const;
   // The matrix as an Eigen sparse matrix (tests, diagnostics; allocates).

@@ -123,6 +123,29 @@ Mat3 spring_jacobian(const BucklingSpring& sp, const VecX& x, bool definite) {
   return dT * nn + t * (Mat3::Identity() - nn);
 }
 
+void spring_force_and_definite_jacobian(const BucklingSpring& sp, const VecX& x, Vec3& f, Mat3& B) {
+  const Vec3 d = seg(x, sp.b) - seg(x, sp.a);
+  if (sp.rest == 0) {
+    f = sp.k * d;
+    B = sp.k * Mat3::Identity();
+    return;
+  }
+  const double s = d.norm();
+  double T, dT, d2T;
+  spring_tension(sp, s, T, dT, d2T);
+  if (s <= kDegenerate * sp.rest) {
+    f.setZero();
+    B = dT * Mat3::Identity();
+    return;
+  }
+  f = (T / s) * d;
+  const Vec3 n = d / s;
+  const Mat3 nn = n * n.transpose();
+  double t, dt;
+  transverse_stiffness(sp, s, T, dT, /*definite=*/true, t, dt);
+  B = dT * nn + t * (Mat3::Identity() - nn);
+}
+
 Vec3 spring_jacobian_derivative(const BucklingSpring& sp, const VecX& x, bool definite, const Vec3& p, const Vec3& q) {
   if (sp.rest == 0) return Vec3::Zero();
   const Vec3 d = seg(x, sp.b) - seg(x, sp.a);

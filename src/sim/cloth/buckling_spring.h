@@ -54,6 +54,10 @@ Vec3 spring_force(const BucklingSpring& sp, const VecX& x);
 // included: its axial and transverse stiffnesses are both k, so the direction never enters.
 Mat3 spring_jacobian(const BucklingSpring& sp, const VecX& x, bool definite);
 
+// spring_force and spring_jacobian(definite = true) from one evaluation of the tension (the step's
+// assembly needs both), equal to them bit for bit.
+void spring_force_and_definite_jacobian(const BucklingSpring& sp, const VecX& x, Vec3& f, Mat3& B);
+
 // d/dd [p . B(d) q] with d = x_b - x_a (N/m^2 times the units of p q): the position derivative of the
 // spring's stiffness met by two vectors, which the exact adjoint of a step needs (the step's matrix
 // holds B). `definite` as for spring_jacobian (its transverse term is cut at the rest length, so this is

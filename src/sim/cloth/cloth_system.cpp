@@ -19,6 +19,26 @@ namespace {
 // Grain sizes: below these a parallel loop costs more than it saves on two cores.
 constexpr int kSpringGrain = 1024;
 constexpr int kParticleGrain = 256;
+
+// "auto": IC(0) below this many particles, where its serial triangular solves are the cheapest CG
+// preconditioner here; multigrid from there on, where IC(0)'s iteration count grows with the sheet's side
+// and multigrid's stays flat (measured: tests/results/bench/solver.csv).
+constexpr int kMultigridFrom = 5000;
+
+Preconditioner preconditioner_kind(const std::string& name, int particles) {
+  if (name == "multigrid" || (name == "auto" && particles >= kMultigridFrom)) return Preconditioner::kMultigrid;
+  if (name == "block_jacobi") return Preconditioner::kBlockJacobi;
+  return Preconditioner::kIncompleteCholesky;
+}
+
+const char* preconditioner_name(Preconditioner p) {
+  switch (p) {
+    case Preconditioner::kMultigrid: return "multigrid";
+    case Preconditioner::kBlockJacobi: return "block_jacobi";
+    case Preconditioner::kIncompleteCholesky: break;
+  }
+  return "incomplete_cholesky";
+}
 }  // namespace
 
 AdjointKind adjoint_kind(const std::string& name) {
@@ -72,15 +92,16 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
     cols[s.a].push_back(s.b);
     cols[s.b].push_back(s.a);
   }
-  K_.set_pattern(cols);
-  D_.set_pattern(cols);
   A_.set_pattern(cols);
   std::vector<std::vector<Incident>> inc(p_);
   for (int k = 0; k < int(springs_.size()); ++k) {
     const BucklingSpring& s = springs_[k];
-    inc[s.a].push_back({k, +1, K_.find(s.a, s.b)});
-    inc[s.b].push_back({k, -1, K_.find(s.b, s.a)});
+    inc[s.a].push_back({k, +1, A_.find(s.a, s.b)});
+    inc[s.b].push_back({k, -1, A_.find(s.b, s.a)});
   }
+  slot_spring_.assign(A_.nonzero_blocks(), -1);
+  for (const auto& list : inc)
+    for (const Incident& in : list) slot_spring_[in.slot] = in.spring;
   incident_start_.assign(1, 0);
   for (auto& list : inc) {
     incident_.insert(incident_.end(), list.begin(), list.end());
@@ -105,13 +126,15 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   rhs_.setZero(3 * p_);
   dv_.setZero(3 * p_);
   contact_K_.assign(p_, Mat3::Zero());
+  diag_K_.assign(p_, Mat3::Zero());
+  diag_D_.assign(p_, Mat3::Zero());
   aw_.setZero(3 * p_);
   w_.setZero(3 * p_);
   c_.setZero(3 * p_);
   direct_solve_ = spec.direct_solver();
   split_x_.resize(spec.max_halvings);
   split_v_.resize(spec.max_halvings);
-  pcg_.resize(p_, spec.block_jacobi() ? Preconditioner::kBlockJacobi : Preconditioner::kIncompleteCholesky);
+  pcg_.resize(p_, preconditioner_kind(spec.cg_preconditioner, p_), spec.nx, spec.ny);
 }
 
 void ClothSystem::initial_state(VecX& x, VecX& v) const {
@@ -132,8 +155,7 @@ void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs) {
   tbb::parallel_for(tbb::blocked_range<int>(0, ns, kSpringGrain), [&](const tbb::blocked_range<int>& r) {
     for (int k = r.begin(); k < r.end(); ++k) {
       const BucklingSpring& s = springs_[k];
-      spring_f_[k] = spring_force(s, x);
-      spring_K_[k] = spring_jacobian(s, x, /*definite=*/true);
+      spring_force_and_definite_jacobian(s, x, spring_f_[k], spring_K_[k]);
       if (k < damped_) {
         spring_f_[k] += damping_force(s, spec_.damping, x, v);
         spring_D_[k] = damping_jacobian_v(s, spec_.damping, x);
@@ -147,18 +169,19 @@ void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs) {
       const double m = mass_[i];
       Vec3 f = gravity_force(m, spec_.gravity) + air_drag_force(spec_.air_drag, m, seg(v, i));
       Mat3 Kii = Mat3::Zero(), Dii = air_drag_jacobian_v(spec_.air_drag, m);
-      for (int k = K_.row_start(i); k < K_.row_start(i + 1); ++k) {
-        K_.block(k).setZero();
-        D_.block(k).setZero();
-      }
+      // A's off-diagonal blocks are the springs' own (one spring per particle pair): K and D are never
+      // stored as matrices, which keeps a 100 x 100 sheet's working set in cache.
       for (int e = incident_start_[i]; e < incident_start_[i + 1]; ++e) {
         const Incident& in = incident_[e];
+        const Mat3& Ks = spring_K_[in.spring];
         f += in.sign * spring_f_[in.spring];
-        K_.block(in.slot) += spring_K_[in.spring];
-        Kii -= spring_K_[in.spring];
+        Kii -= Ks;
         if (in.spring < damped_) {
-          D_.block(in.slot) += spring_D_[in.spring];
-          Dii -= spring_D_[in.spring];
+          const Mat3& Ds = spring_D_[in.spring];
+          A_.block(in.slot) = -h * Ds - h * h * Ks;
+          Dii -= Ds;
+        } else {
+          A_.block(in.slot) = -h * Mat3::Zero() - h * h * Ks;
         }
       }
       ContactForce c;
@@ -171,12 +194,11 @@ void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs) {
           Dii += c.dfdv;
         }
       Kii += Kc;
-      const int d = K_.diag_slot(i);
-      K_.block(d) = Kii;
-      D_.block(d) = Dii;
+      diag_K_[i] = Kii;
+      diag_D_[i] = Dii;
       seg(force_, i) = f;
-      for (int k = K_.row_start(i); k < K_.row_start(i + 1); ++k)
-        A_.block(k) = -h * D_.block(k) - h * h * K_.block(k);
+      const int d = A_.diag_slot(i);
+      A_.block(d) = -h * Dii - h * h * Kii;
       A_.block(d) += m * Mat3::Identity();
     }
   });
@@ -220,15 +242,21 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
 Vec3 ClothSystem::stiffness_times_velocity(int i, const VecX& v) const {
   const Vec3 vi = seg(v, i);
   Vec3 kv = contact_K_[i] * vi;
-  for (int k = K_.row_start(i); k < K_.row_start(i + 1); ++k)
-    if (K_.col(k) != i) kv.noalias() += K_.block(k) * (seg(v, K_.col(k)) - vi);
+  for (int k = A_.row_start(i); k < A_.row_start(i + 1); ++k)
+    if (A_.col(k) != i) kv.noalias() += spring_K_[slot_spring_[k]] * (seg(v, A_.col(k)) - vi);
   return kv;
 }
 
 ClothSystem::Energy ClothSystem::energy(int n, const VecX& x, const VecX& v) const {
+  Energy e = state_energy(x, v);
+  for (int i = 0; i < p_; ++i)
+    for (const auto& c : colliders_) e.contact += c->energy(n, seg(x, i));
+  return e;
+}
+
+ClothSystem::Energy ClothSystem::state_energy(const VecX& x, const VecX& v) const {
   Energy e;
   for (int i = 0; i < p_; ++i) {
-    for (const auto& c : colliders_) e.contact += c->energy(n, seg(x, i));
     if (!free_[i]) continue;
     e.kinetic += 0.5 * mass_[i] * seg(v, i).squaredNorm();
     e.gravity -= mass_[i] * spec_.gravity.dot(seg(x, i));
@@ -245,6 +273,25 @@ ClothSystem::Energy ClothSystem::energy(int n, const VecX& x, const VecX& v) con
   });
   for (int c = 0; c < chunks; ++c) e.elastic += parts[c];
   return e;
+}
+
+// A step's start is usually the last accepted substep's end, whose springs were just summed: reuse that
+// sum (a buckled sheet's spring energies cost as much as a third of a step). Keyed by the state itself,
+// so a caller that steps from anywhere else gets a fresh sum; the contact part depends on n and is
+// always recomputed.
+ClothSystem::Energy ClothSystem::energy_at_start(int n, const VecX& x, const VecX& v) {
+  if (!(energy_x_.size() == x.size() && energy_x_ == x && energy_v_ == v)) return energy(n, x, v);
+  Energy e = cached_energy_;
+  for (int i = 0; i < p_; ++i)
+    for (const auto& c : colliders_) e.contact += c->energy(n, seg(x, i));
+  return e;
+}
+
+void ClothSystem::remember_energy(const VecX& x, const VecX& v, const Energy& e) {
+  energy_x_ = x;
+  energy_v_ = v;
+  cached_energy_ = e;
+  cached_energy_.contact = 0;
 }
 
 PcgResult ClothSystem::solve(const VecX& b, VecX& x, bool warm) {
@@ -275,12 +322,13 @@ bool ClothSystem::checked_step(int n, int depth, double t0, const VecX& x, const
   if (depth < spec_.max_halvings) {
     // Backward Euler with damping never gains energy; the linearised step does when it moves particles
     // fast across springs or into colliders, and halving the step shrinks what it invents ~4-16 times.
-    const Energy before = energy(n, x, v), after = solved ? energy(n, x_next, v_next) : Energy{};
+    const Energy before = energy_at_start(n, x, v), after = solved ? energy(n, x_next, v_next) : Energy{};
     const double work = solved ? external_work(u, x, x_next) : 0.0;
     // The energy the step moves is the tolerance's scale (a NaN gain fails the test and splits).
     const double moved = before.kinetic + before.elastic + before.contact + std::abs(work) +
                          std::abs(after.gravity - before.gravity);
     accept = solved && after.total() - before.total() - work <= 1e-3 * moved + 1e-12;
+    if (accept) remember_energy(x_next, v_next, after);
   }
   if (accept) {
     if (int(rec.substeps.size()) <= rec.count) rec.substeps.emplace_back();
@@ -398,6 +446,21 @@ void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v,
   uhat += h * w;
 }
 
+BlockSparse3 ClothSystem::block_matrix(const std::vector<Mat3>& per_spring, const std::vector<Mat3>& diagonal,
+                                       bool damped_only) const {
+  BlockSparse3 m = A_;
+  for (int i = 0; i < p_; ++i)
+    for (int k = A_.row_start(i); k < A_.row_start(i + 1); ++k) {
+      const int sp = slot_spring_[k];
+      if (sp < 0) m.block(k) = diagonal[i];
+      else m.block(k) = damped_only && sp >= damped_ ? Mat3::Zero() : per_spring[sp];
+    }
+  return m;
+}
+
+SpMat ClothSystem::stiffness_matrix() const { return block_matrix(spring_K_, diag_K_, false).to_sparse(); }
+SpMat ClothSystem::damping_matrix() const { return block_matrix(spring_D_, diag_D_, true).to_sparse(); }
+
 void ClothSystem::save_step_context(int n, VecX& context) const {
   if (last_forward_n_ == n - 1) context = dv_;
   else context.resize(0);
@@ -416,7 +479,7 @@ std::string ClothSystem::describe() const {
   std::ostringstream os;
   os << "cloth: " << spec_.nx << "x" << spec_.ny << " particles, " << springs_.size() << " springs, "
      << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, "
-     << (direct_solve_ ? std::string("sparse ") + FilteredDirect::backend() : "PCG (" + spec_.cg_preconditioner + ")") << ", " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
+     << (direct_solve_ ? std::string("sparse ") + FilteredDirect::backend() : std::string("PCG (") + preconditioner_name(preconditioner_kind(spec_.cg_preconditioner, p_)) + ")") << ", " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
   return os.str();
 }
 

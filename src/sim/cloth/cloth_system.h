@@ -87,8 +87,8 @@ class ClothSystem final : public System {
   void assemble(int n, const VecX& x, const VecX& v, double hs = 0);
   // Results of the last assemble: f (3p, N), K (N/m), D (N s/m), A (kg), as Eigen matrices (allocate).
   const VecX& force() const { return force_; }
-  SpMat stiffness_matrix() const { return K_.to_sparse(); }
-  SpMat damping_matrix() const { return D_.to_sparse(); }
+  SpMat stiffness_matrix() const;
+  SpMat damping_matrix() const;
   SpMat system_matrix() const { return A_.to_sparse(); }
 
   const ClothSpec& spec() const { return spec_; }
@@ -105,6 +105,8 @@ class ClothSystem final : public System {
     double total() const { return kinetic + gravity + elastic + contact; }
   };
   Energy energy(int n, const VecX& x, const VecX& v) const;
+  // The same without the colliders' part (which depends on n).
+  Energy state_energy(const VecX& x, const VecX& v) const;
   Vec3 stiffness_times_velocity(int i, const VecX& v) const;
   // PCG iterations of the last forward / backward solve (benchmarks, logs).
   int last_cg_iterations() const { return last_cg_; }
@@ -123,6 +125,10 @@ class ClothSystem final : public System {
                        const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat);
   // Solves the assembled A on the free set (x: prescribed values on pins, warm start on free ones).
   PcgResult solve(const VecX& b, VecX& x, bool warm);
+  Energy energy_at_start(int n, const VecX& x, const VecX& v);
+  void remember_energy(const VecX& x, const VecX& v, const Energy& e);
+  // K or D as a block matrix on A's pattern (diagnostics; allocates).
+  BlockSparse3 block_matrix(const std::vector<Mat3>& per_spring, const std::vector<Mat3>& diagonal, bool damped_only) const;
   // Work (J) of the control u on the free particles and of the pins on their springs from x0 to x1.
   double external_work(const VecX& u, const VecX& x0, const VecX& x1) const;
 
@@ -150,7 +156,9 @@ class ClothSystem final : public System {
   std::vector<Mat3> spring_K_, spring_D_;
   mutable std::vector<double> energy_parts_;  // energy(): one partial sum per fixed chunk of springs
   std::vector<Mat3> contact_K_;  // per particle: the colliders' part of K's diagonal block
-  BlockSparse3 K_, D_, A_;
+  BlockSparse3 A_;
+  std::vector<int> slot_spring_;        // per block of A: the spring joining its row and column, -1 on the diagonal
+  std::vector<Mat3> diag_K_, diag_D_;   // per particle: K's and D's diagonal blocks
   VecX force_, rhs_, dv_, aw_;
   FilteredPcg pcg_;
   FilteredDirect direct_;  // cloth.solver = "direct"
@@ -160,6 +168,8 @@ class ClothSystem final : public System {
   std::vector<VecX> split_x_, split_v_;  // per depth: the state between two halves of a split step
   VecX adj_x_, adj_v_, adj_u_;           // adjoint of one substep (walking split steps back)
   int last_substeps_ = 0;
+  VecX energy_x_, energy_v_;  // the state whose collider-free energy is cached_energy_
+  Energy cached_energy_;
   VecX c_;   // v + dv of the step being walked back
   AdjointKind adjoint_ = AdjointKind::kExact;
   int last_forward_n_ = -2, last_adjoint_n_ = -2;  // steps of the last solves, -2: none

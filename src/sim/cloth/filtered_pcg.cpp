@@ -8,8 +8,12 @@
 
 namespace kf {
 
-void FilteredPcg::resize(int p, Preconditioner kind) {
+void FilteredPcg::resize(int p, Preconditioner kind, int nx, int ny) {
   kind_ = kind;
+  nx_ = nx;
+  ny_ = ny;
+  mg_ready_ = false;
+  if (kind == Preconditioner::kMultigrid && nx * ny != p) kind_ = Preconditioner::kIncompleteCholesky;
   inv_diag_.assign(p, Mat3::Identity());
   r_.setZero(3 * p);
   z_.setZero(3 * p);
@@ -18,6 +22,15 @@ void FilteredPcg::resize(int p, Preconditioner kind) {
 }
 
 void FilteredPcg::prepare(const BlockSparse3& A, const std::vector<char>& free) {
+  ic_ok_ = mg_ok_ = false;
+  if (kind_ == Preconditioner::kMultigrid) {
+    if (!mg_ready_) {  // the pattern and the pins are the sheet's: the hierarchy is built once
+      mg_.setup(nx_, ny_, A, free);
+      mg_ready_ = true;
+    }
+    mg_ok_ = mg_.prepare(A);
+    if (mg_ok_) return;
+  }
   if (kind_ == Preconditioner::kIncompleteCholesky) {
     if (int(lower_.size()) != A.nonzero_blocks()) lower_.assign(A.nonzero_blocks(), Mat3::Zero());
     ic_ok_ = factor_ic(A, free);
@@ -78,8 +91,12 @@ void FilteredPcg::filter(const std::vector<char>& free, VecX& y) const {
 }
 
 void FilteredPcg::precondition(const BlockSparse3& A, const std::vector<char>& free, const VecX& r,
-                               VecX& z) const {
+                               VecX& z) {
   const int n = int(free.size());
+  if (mg_ok_) {
+    mg_.apply(A, r, z);
+    return;
+  }
   if (!ic_ok_) {
     for (int i = 0; i < n; ++i) seg(z, i).noalias() = inv_diag_[i] * seg(r, i);
     return;
@@ -142,6 +159,7 @@ PcgResult FilteredPcg::solve(const BlockSparse3& A, const std::vector<char>& fre
     }
     precondition(A, free, r_, z_);
     const double rz_new = r_.dot(z_);
+    if (!(rz_new > 0)) break;  // the preconditioner is not positive definite here
     p_ = z_ + (rz_new / rz) * p_;
     rz = rz_new;
   }

@@ -1,15 +1,17 @@
 #pragma once
 // Preconditioned conjugate gradients with the Baraff-Witkin filter: particles marked constrained keep the
 // value the caller put in x, and the solve runs on the free particles only (S A x = S b).
-// Preconditioner: block incomplete Cholesky IC(0) on the free set (the factor keeps A's block pattern),
-// or the inverse of each free particle's 3x3 diagonal block (block Jacobi). IC(0) falls back to block
-// Jacobi for a step whose factorisation meets a pivot that is not positive definite.
+// Preconditioner: a multigrid V-cycle over the sheet's grid (GridMultigrid), block incomplete Cholesky
+// IC(0) on the free set (the factor keeps A's block pattern), or the inverse of each free particle's 3x3
+// diagonal block (block Jacobi). Multigrid and IC(0) fall back to block Jacobi for a step whose matrix
+// they cannot use (a pivot that is not positive definite).
 // Reductions and triangular solves are serial over a fixed order, so results do not depend on the thread
 // count.
 #include <vector>
 
 #include "core/types.h"
 #include "sim/cloth/block_sparse.h"
+#include "sim/cloth/grid_multigrid.h"
 
 namespace kf {
 
@@ -19,17 +21,19 @@ struct PcgResult {
   double relative_residual = 0;  // |S (b - A x)| / |S b|
 };
 
-enum class Preconditioner { kBlockJacobi, kIncompleteCholesky };
+enum class Preconditioner { kBlockJacobi, kIncompleteCholesky, kMultigrid };
 
 class FilteredPcg {
  public:
-  // Preallocates for p particles.
-  void resize(int p, Preconditioner kind = Preconditioner::kIncompleteCholesky);
+  // Preallocates for p particles; multigrid needs the grid (p = nx ny).
+  void resize(int p, Preconditioner kind = Preconditioner::kIncompleteCholesky, int nx = 0, int ny = 0);
   // Builds the preconditioner from A (symmetric, blocks A_ji = A_ij^T) on free particles. Call after A
   // changes, before solve.
   void prepare(const BlockSparse3& A, const std::vector<char>& free);
   // True when the last prepare built an incomplete Cholesky factor (false: block Jacobi).
   bool incomplete_cholesky() const { return ic_ok_; }
+  // True when the last prepare built the multigrid hierarchy's operators.
+  bool multigrid() const { return mg_ok_; }
   // A: symmetric positive definite on the free set. b, x: 3p. On entry x holds the prescribed values on
   // constrained particles and, when `warm` is true, the initial guess on free ones (otherwise they start
   // at zero). Stops at |r| <= tol |S b|.
@@ -38,10 +42,12 @@ class FilteredPcg {
 
  private:
   void filter(const std::vector<char>& free, VecX& y) const;
-  void precondition(const BlockSparse3& A, const std::vector<char>& free, const VecX& r, VecX& z) const;
+  void precondition(const BlockSparse3& A, const std::vector<char>& free, const VecX& r, VecX& z);
   bool factor_ic(const BlockSparse3& A, const std::vector<char>& free);
   Preconditioner kind_ = Preconditioner::kIncompleteCholesky;
-  bool ic_ok_ = false;
+  bool ic_ok_ = false, mg_ok_ = false, mg_ready_ = false;
+  int nx_ = 0, ny_ = 0;
+  GridMultigrid mg_;
   std::vector<Mat3> inv_diag_;  // block Jacobi: A_ii^-1; IC(0): L_ii^-1 (lower triangular)
   std::vector<Mat3> lower_;     // IC(0): L_ij in A's slot (i, j), j < i
   VecX r_, z_, p_, q_;
