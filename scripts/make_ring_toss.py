@@ -179,7 +179,7 @@ def make(n, frames, key_frames, keyed, max_evaluations):
             {"substeps": 2, "max_evaluations": max_evaluations[0],
              "controls": {"kind": "initial_rigid_velocity", "alpha": 1e-5}},
             {"substeps": 2, "max_evaluations": max_evaluations[1]}]},
-        "render": {"camera": {"eye": [0.3, 1.7, 2.4], "target": [-0.15, 0.9, 0]}},
+        "render": {"camera": {"eye": [0.6, 1.5, 4.4], "target": [0.6, 0.75, 0]}},  # the whole flight, side on
     }
     return scene, summary
 
