@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the cloth figure scene whose keyframes list one target per particle: shapes.json (the ring toss,
-scenes/ring-toss.json, is written by hand).
+scenes/ring-toss.json, is written by scripts/make_ring_toss.py).
 
 Run from the repository root: python3 scripts/make_cloth_scenes.py
 """

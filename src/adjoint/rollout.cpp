@@ -124,10 +124,17 @@ void backward(System& sys, const Rollout& r, const StepControl& u, const StateCo
         sys.step(n, seg_x[n - k], seg_v[n - k], u(n), seg_x[n - k + 1], seg_v[n - k + 1], *seg_tape[n - k]);
     }
     for (int n = e - 1; n >= k; --n) {
-      sys.step_adjoint(n, state_x(n), state_v(n), u(n), record(n), xhat, vhat, xhat_prev, vhat_prev, uhat);
-      du(n, uhat);
-      xhat.swap(xhat_prev);
-      vhat.swap(vhat_prev);
+      if (xhat.isZero(0.0) && vhat.isZero(0.0)) {
+        // After the last keyframe (a sheet landing, say) the adjoint is exactly zero and the step's
+        // adjoint linear in it: skip its solve.
+        uhat.setZero();
+        du(n, uhat);
+      } else {
+        sys.step_adjoint(n, state_x(n), state_v(n), u(n), record(n), xhat, vhat, xhat_prev, vhat_prev, uhat);
+        du(n, uhat);
+        xhat.swap(xhat_prev);
+        vhat.swap(vhat_prev);
+      }
       if (cost.active(n)) cost.eval(n, state_x(n), state_v(n), xhat, vhat);
     }
   }

@@ -32,7 +32,7 @@ void add_figure_command(CLI::App& app) {
               "  fig. 2  keyframe figure out/race                      (a strip over time)\n"
               "  fig. 3  keyframe figure out/path --overlay --frames 0,60,120\n"
               "  fig. 4  keyframe figure out/shapes\n"
-              "  fig. 5  keyframe figure out/ring-toss --frames 0,6,12,18,24\n"
+              "  fig. 5  keyframe figure out/ring-toss --frames 0,5,9,14,21,28\n"
               "  fig. 6  keyframe figure out/cape-a out/cape-blend out/cape-b --columns --frames 0,15,last");
   sub->callback([=] {
     render::FigureRequest r = *req;

@@ -234,11 +234,18 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   for (size_t s = 0; s < stages.size() && !job.interrupted; ++s) {
     time.substeps = stages[s].substeps;
     if (s > 0) job.sys = make_system(scene, time.h());
-    job.problem = std::make_unique<Problem>(scene, time, *job.sys);
+    Scene stage_scene = scene;  // a stage may optimise a coarser control parameterisation
+    if (stages[s].controls) stage_scene.controls = *stages[s].controls;
+    VecX& z = job.z;
+    VecX v0_before;  // the initial velocities the previous stage's kind gave, when the kind changes
+    if (job.problem && job.problem->controls().kind() != std::string(control_kind_name(stage_scene.controls.kind)))
+      job.problem->controls().initial_velocity(z, v0_before);
+    job.problem = std::make_unique<Problem>(stage_scene, time, *job.sys);
     Problem& problem = *job.problem;
     if (opt.checkpoint_every >= 0) problem.set_checkpoint_every(opt.checkpoint_every);
-    VecX& z = job.z;
-    z = z.size() == 0 ? problem.initial_guess() : problem.controls().remap_from(z, z_time);
+    if (z.size() == 0) z = problem.initial_guess();
+    else if (v0_before.size()) z = problem.controls().from_initial_velocity(v0_before);
+    else z = problem.controls().remap_from(z, z_time);
     if (z.size() != problem.size())
       throw InputError((dir / "controls.bin").string() + ": holds " + std::to_string(z.size()) +
                        " controls, the scene needs " + std::to_string(problem.size()));

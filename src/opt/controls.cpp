@@ -1,6 +1,7 @@
 #include "opt/controls.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include <Eigen/Geometry>  // cross products
 
@@ -129,6 +130,16 @@ void Controls::initial_velocity(const VecX& z, VecX& v0) const {
   if (rigid_) return rigid_velocity(z, v0);
   for (int i = 0; i < particles_; ++i)
     for (int c = 0; c < nc; ++c) v0[3 * i + comps_[c]] = z[i * nc + c];
+}
+
+VecX Controls::from_initial_velocity(const VecX& v0) const {
+  if (kind_ != ControlKind::kInitialVelocity || rigid_)
+    throw std::logic_error("Controls::from_initial_velocity: only for per-particle initial velocities");
+  const int nc = int(comps_.size());
+  VecX z(size());
+  for (int i = 0; i < particles_; ++i)
+    for (int c = 0; c < nc; ++c) z[i * nc + c] = v0[3 * i + comps_[c]];
+  return z;
 }
 
 void Controls::gather_initial_velocity(const VecX& dv0, VecX& dz) const {

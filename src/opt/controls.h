@@ -34,6 +34,9 @@ class Controls {
   void add_step_gradient(int n, const VecX& uhat, VecX& dz) const;
   // The initial velocities z gives (3p).
   void initial_velocity(const VecX& z, VecX& v0) const;
+  // The per-particle initial-velocity controls (size()) that give v0 (3p), e.g. a rigid throw's velocities
+  // carried into the next stage. Only for initial_velocity control.
+  VecX from_initial_velocity(const VecX& v0) const;
   // dphi/dv0 -> dphi/dz for initial-velocity control, added into dz (nothing for force controls).
   void gather_initial_velocity(const VecX& dv0, VecX& dz) const;
   // Control effort ½α∫‖u‖²dt (forces), ½α‖v0 − v0_scene‖² (initial velocities) or ½α‖(Δv, ω)‖² (rigid);

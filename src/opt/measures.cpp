@@ -219,6 +219,11 @@ nlohmann::json figure_measures(const Scene& scene, const Trajectory& t) {
                                 nlohmann::json m = ring_measures(*torus, t);
                                 m["collider"] = int(k);
                                 out.push_back(m);
+                              } else if (const auto* ground = std::get_if<GroundShape>(&cloth.colliders[k].shape)) {
+                                if (!cloth.pins.empty()) continue;  // a free sheet's landing
+                                nlohmann::json m = ground_measures(*ground, cloth.colliders[k].thickness, t);
+                                m["collider"] = int(k);
+                                out.push_back(m);
                               }
                           },
                       });
@@ -253,6 +258,23 @@ nlohmann::json cape_end_state(const Scene& scene, const Trajectory& run, const T
   return {{"frame", pos->frame}, {"cape_length", length}, {"controlled", of(run)}, {"uncontrolled", of(uncontrolled)}};
 }
 
+nlohmann::json ground_measures(const GroundShape& ground, double thickness, const Trajectory& t) {
+  const Vec3 n = ground.normal.normalized();
+  const VecX& x = t.x.back();
+  double lowest = std::numeric_limits<double>::infinity(), sum = 0;
+  const int p = int(x.size() / 3);
+  for (int i = 0; i < p; ++i) {
+    const double h = n.dot(seg(x, i) - ground.point);
+    lowest = std::min(lowest, h);
+    sum += h;
+  }
+  // Resting on it: within two contact thicknesses (the contact springs hold a sheet about one above it).
+  return {{"type", "ground"},
+          {"lowest_at_end", lowest},
+          {"mean_height_at_end", sum / std::max(1, p)},
+          {"on_ground_at_end", lowest <= 2 * thickness}};
+}
+
 nlohmann::json ring_measures(const TorusShape& torus, const Trajectory& t) {
   const TorusCollider ring(torus, 0.0, 0.0, 0.0);  // distances only
   const Vec3 axis = torus.axis.normalized();
@@ -283,13 +305,39 @@ nlohmann::json ring_measures(const TorusShape& torus, const Trajectory& t) {
     }
     prev = com;
   }
+  // Between frames, on the straight path of each particle: the simulation's contacts act only at steps,
+  // so a fast particle could pass through the tube unseen by the frames. Paths whose whole length is
+  // farther from the surface than their half length cannot come closer than that; the others are sampled
+  // at a spacing of a quarter of the tube's radius.
+  double min_between = min_phi;
+  const double spacing = 0.25 * torus.tube_radius;
+  for (int f = 0; f + 1 < t.frames(); ++f)
+    for (int i = 0; i < t.x[size_t(f)].size() / 3; ++i) {
+      const Vec3 a = seg(t.x[size_t(f)], i), b = seg(t.x[size_t(f) + 1], i);
+      double phi;
+      Vec3 n;
+      Mat3 dn;
+      ring.distance(0.5 * (a + b), phi, n, dn);
+      const double half = 0.5 * (b - a).norm();
+      if (phi - half >= min_between) continue;  // cannot lower the minimum
+      const int samples = 1 + int(std::ceil(2 * half / spacing));
+      for (int k = 0; k <= samples; ++k) {
+        ring.distance(a + (b - a) * (double(k) / samples), phi, n, dn);
+        min_between = std::min(min_between, phi);
+      }
+    }
+  // Where the sheet ends, along the ring's axis from its plane, in the direction it crossed (positive: beyond).
+  const Vec3 end_com = mean_of(t.x.back(), {});
+  const double start_side = axis.dot(mean_of(t.x.front(), {}) - torus.center);
   nlohmann::json m = {{"type", "ring"}};
   m["crossings"] = crossings;
   m["inner_radius"] = inner;
   m["through_ring"] = crossings > 0 && min_axis < inner;
   m["min_distance_to_ring_axis_when_crossing"] = crossings > 0 ? nlohmann::json(min_axis) : nlohmann::json();
   m["min_signed_distance"] = min_phi;
-  m["penetration_free"] = min_phi >= 0;
+  m["min_signed_distance_between_frames"] = min_between;
+  m["penetration_free"] = min_phi >= 0 && min_between >= 0;
+  m["end_beyond_ring_plane"] = (start_side < 0 ? 1.0 : -1.0) * axis.dot(end_com - torus.center);
   return m;
 }
 

@@ -20,8 +20,13 @@ namespace kf {
 //  through_ring (the centre of mass crosses the ring's plane inside the tube's inner circle),
 //  crossings (plane crossings of the centre of mass), min_distance_to_ring_axis_when_crossing (metres, null
 //  without a crossing), inner_radius (metres), min_signed_distance (to the torus surface over all particles
-//  and frames, metres; negative is penetration), penetration_free. Frames only: a contact between frames
-//  is not seen. And one "sheet" object for a cloth without pins: flip_degrees (the largest angle between
+//  and frames, metres; negative is penetration), min_signed_distance_between_frames (also along each
+//  particle's straight path from one frame to the next, sampled at a quarter of the tube radius),
+//  penetration_free (both >= 0), end_beyond_ring_plane (the last frame's centre of mass along the axis from
+//  the ring's plane, positive on the side away from the start, metres). For a cloth without pins, one
+//  object per ground collider ("type": "ground", "collider"): lowest_at_end, mean_height_at_end (particles
+//  above the plane at the last frame, metres), on_ground_at_end (lowest within two contact thicknesses).
+//  And one "sheet" object for a cloth without pins: flip_degrees (the largest angle between
 //  the sheet's normal, from its corner diagonals, and its normal at frame 0, over all frames) and
 //  flip_degrees_at_end.
 nlohmann::json figure_measures(const Scene& scene, const Trajectory& frames);
@@ -34,6 +39,7 @@ nlohmann::json cape_end_state(const Scene& scene, const Trajectory& run, const T
 
 // Ring measures of one torus collider over the frames of a run (the "ring" object described above).
 nlohmann::json ring_measures(const TorusShape& torus, const Trajectory& frames);
+nlohmann::json ground_measures(const GroundShape& ground, double thickness, const Trajectory& frames);
 
 // Nearest-neighbour distance of each particle in the ground plane (x, z) at one state.
 std::vector<double> nearest_neighbour_spacing(const VecX& x);

@@ -1,5 +1,6 @@
 #pragma once
 // Keyframes and other objective terms as the scene file states them (validated, not yet evaluated).
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <variant>
@@ -80,10 +81,13 @@ struct ControlSpec {
   double alpha = 1e-4;  // weight of the control effort ½α‖u‖²
 };
 
-// One stage of coarse-to-fine continuation: optimise at this many substeps per frame.
+// One stage of continuation: optimise at this many substeps per frame, optionally over a coarser control
+// parameterisation. With initial-velocity control a stage may optimise the rigid throw (6 variables) first:
+// the next stage starts from the per-particle velocities it gives, so the stiff springs begin unexcited.
 struct StageSpec {
   int substeps = 1;
   int max_evaluations = 100;
+  std::optional<ControlSpec> controls;  // empty: the scene's controls
 };
 
 struct OptimizerSpec {

@@ -101,10 +101,12 @@ ObjectiveSpec parse_objective(Block b, const Scene& s) {
   return o;
 }
 
-ControlSpec parse_controls(Block b, const Scene& s) {
+// `only_initial`: a schedule stage's controls, limited to the two initial-velocity kinds.
+ControlSpec parse_controls(Block b, bool only_initial = false) {
   ControlSpec c;
-  const ControlKind kinds[] = {ControlKind::kPerStep, ControlKind::kPerFrame, ControlKind::kInitialVelocity,
-                               ControlKind::kInitialRigidVelocity};
+  if (only_initial) c.kind = ControlKind::kInitialRigidVelocity;
+  std::vector<ControlKind> kinds = {ControlKind::kInitialVelocity, ControlKind::kInitialRigidVelocity};
+  if (!only_initial) kinds.insert(kinds.begin(), {ControlKind::kPerStep, ControlKind::kPerFrame});
   std::vector<std::string> names;
   for (ControlKind k : kinds) names.push_back(control_kind_name(k));
   const std::string kind = b.string("kind", control_kind_name(c.kind), names);
@@ -115,16 +117,26 @@ ControlSpec parse_controls(Block b, const Scene& s) {
   return c;
 }
 
-OptimizerSpec parse_optimizer(Block b) {
+OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls) {
   OptimizerSpec o;
   o.max_evaluations = b.integer("max_evaluations", o.max_evaluations, 0, 1000000);
   o.ftol_rel = b.number("ftol_rel", o.ftol_rel, 0.0, 1.0);
   o.max_seconds = b.number("max_seconds", o.max_seconds, 0.0, 1e7);
   o.memory = b.integer("memory", o.memory, 1, 100);
-  for (Block& stage : b.array("schedule")) {
+  std::vector<Block> stages = b.array("schedule");
+  for (size_t k = 0; k < stages.size(); ++k) {
+    Block& stage = stages[k];
     StageSpec st;
     st.substeps = stage.integer("substeps", 1, 10000);
     st.max_evaluations = stage.integer("max_evaluations", st.max_evaluations, 0, 1000000);
+    if (stage.has("controls")) {
+      // Only between the two initial-velocity kinds: their controls carry over as the velocities they give,
+      // and the last stage is the scene's own kind (what the run's controls.bin holds).
+      if (scene_controls.kind != ControlKind::kInitialVelocity)
+        stage.fail("controls", "a stage's own controls only with the scene's controls.kind \"initial_velocity\"");
+      if (k + 1 == stages.size()) stage.fail("controls", "the last stage uses the scene's controls (no \"controls\")");
+      st.controls = parse_controls(stage.child("controls"), true);
+    }
     stage.finish();
     o.schedule.push_back(st);
   }
@@ -169,8 +181,8 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& file) {
   }
   if (root.has("character")) s.character = parse_character_spec(root.child("character"), s);
   for (Block& b : root.array("objectives")) s.objectives.push_back(parse_objective(std::move(b), s));
-  s.controls = parse_controls(root.child("controls"), s);
-  s.optimizer = parse_optimizer(root.child("optimizer"));
+  s.controls = parse_controls(root.child("controls"));
+  s.optimizer = parse_optimizer(root.child("optimizer"), s.controls);
   {
     Block b = root.child("render");
     s.render = parse_render_spec(b);

@@ -3,10 +3,19 @@
 // Also the approximate adjoint on scenes/cloth-gradcheck.json (6x6 cloth, 40 steps) at the scene's step.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
 #include <nlohmann/json.hpp>
 
+#include "app/optimize_job.h"
 #include "opt/gradcheck.h"
 #include "opt/measures.h"
 #include "opt/optimizer.h"
@@ -123,6 +132,71 @@ TEST(ClothFigures, RingTossPassesThroughTheRingWithoutPenetrating) {
   EXPECT_LT(o.measures.at(0).at("error").get<double>(), 0.01);
 }
 
+// The measure object of `type` in a report's measures (the last one when there are several).
+const json& measure(const json& report, const std::string& type) {
+  const json* found = nullptr;
+  for (const json& m : report.at("measures"))
+    if (m.at("type") == type) found = &m;
+  if (!found) throw std::runtime_error("no " + type + " measure in " + report.at("measures").dump());
+  return *found;
+}
+
+TEST(ClothFigures, RingTossTurnsOverThroughTheRingAndLandsBeyondIt) {
+  // tests/figures/ring-toss-small.json, written by scripts/make_ring_toss.py beside scenes/ring-toss.json: a
+  // 12x12 sheet, the full scene's keyframes (a roll that turns it over) and its two stages -- the rigid throw,
+  // then one velocity per particle starting from it -- through `keyframe optimize`'s own job.
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("keyframe_ring_toss_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  OptimizeOptions opt;
+  opt.out = dir.string();
+  opt.quiet = true;
+  optimize_job(std::string(KEYFRAME_SOURCE_DIR) + "/tests/figures/ring-toss-small.json", opt);
+  std::ifstream in(dir / "report.json");
+  const json report = json::parse(in);
+  EXPECT_EQ(report.at("controls"), "initial_velocity");
+  EXPECT_EQ(report.at("control_variables").get<int>(), 3 * 12 * 12);
+  EXPECT_EQ(report.at("stages").get<int>(), 2);
+  EXPECT_LT(report.at("final_objective").get<double>(), 0.1 * report.at("initial_objective").get<double>());
+  const json& ring = measure(report, "ring");
+  EXPECT_TRUE(ring.at("through_ring").get<bool>()) << ring.dump();
+  EXPECT_TRUE(ring.at("penetration_free").get<bool>()) << ring.dump();
+  EXPECT_GT(ring.at("end_beyond_ring_plane").get<double>(), 0.0) << ring.dump();
+  const json& sheet = measure(report, "sheet");
+  EXPECT_GE(sheet.at("flip_degrees").get<double>(), 150.0) << sheet.dump();
+  const json& ground = measure(report, "ground");
+  EXPECT_TRUE(ground.at("on_ground_at_end").get<bool>()) << ground.dump();
+  // On this sheet the per-particle stage lowers the keyframe error of the rigid throw it starts from
+  // (iterations.csv: phi, its "effort" column, and the stage of each evaluation; the two stages' efforts
+  // measure different things, so they are left out).
+  std::ifstream csv(dir / "iterations.csv");
+  auto cells_of = [](const std::string& line) {
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    for (std::string c; std::getline(row, c, ',');) cells.push_back(c);
+    return cells;
+  };
+  std::string line;
+  std::getline(csv, line);
+  const std::vector<std::string> header = cells_of(line);
+  const auto column = [&](const std::string& name) {
+    return int(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  const int phi_col = column("phi"), stage_col = column("stage"), effort_col = column("effort");
+  ASSERT_LT(effort_col, int(header.size())) << line;
+  double best[2] = {INFINITY, INFINITY};
+  while (std::getline(csv, line)) {
+    const std::vector<std::string> cells = cells_of(line);
+    ASSERT_EQ(cells.size(), header.size()) << line;
+    const int stage = std::stoi(cells[size_t(stage_col)]);
+    ASSERT_TRUE(stage == 1 || stage == 2) << line;
+    const double keyframes = std::stod(cells[size_t(phi_col)]) - std::stod(cells[size_t(effort_col)]);
+    if (std::isfinite(keyframes)) best[stage - 1] = std::min(best[stage - 1], keyframes);
+  }
+  EXPECT_LT(best[1], 0.75 * best[0]) << "keyframe terms: rigid stage " << best[0] << ", per-particle stage " << best[1];
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
 TEST(ClothFigures, SheetMeasureSeesAHalfTurn) {
   // A free 2x2 sheet in the x-z plane, rolled about x by 0, 90, 180 and then 120 degrees.
   const Scene scene = parse_scene(R"({"time": {"frames": 3}, "cloth": {"nx": 2, "ny": 2, "width": 1, "height": 1,
@@ -163,6 +237,18 @@ TEST(ClothFigures, RingMeasuresSeeAMissAndAPenetration) {
   t.x = {Vec3(-0.01, 0.05, 0), Vec3(0.01, 0.05, 0)};
   m = ring_measures(torus, t);
   EXPECT_TRUE(m.at("through_ring").get<bool>());
+  EXPECT_TRUE(m.at("penetration_free").get<bool>());
+  EXPECT_GT(m.at("end_beyond_ring_plane").get<double>(), 0.0);
+  // Outside the tube at both frames, but the straight path between them runs through its core.
+  t.x = {Vec3(-0.1, 0.3, 0), Vec3(0.1, 0.3, 0)};
+  m = ring_measures(torus, t);
+  EXPECT_GT(m.at("min_signed_distance").get<double>(), 0.0);
+  EXPECT_NEAR(m.at("min_signed_distance_between_frames").get<double>(), -0.03, 1e-3);
+  EXPECT_FALSE(m.at("penetration_free").get<bool>());
+  // The same jump beside the tube (0.05 from its core) stays free.
+  t.x = {Vec3(-0.1, 0.22, 0), Vec3(0.1, 0.22, 0)};
+  m = ring_measures(torus, t);
+  EXPECT_NEAR(m.at("min_signed_distance_between_frames").get<double>(), 0.05, 1e-3);
   EXPECT_TRUE(m.at("penetration_free").get<bool>());
 }
 

@@ -54,6 +54,9 @@ std::vector<Case> cases() {
       {"evaluations_negative", replace(g, R"("max_evaluations": 5)", R"("max_evaluations": -5)"), "/optimizer/max_evaluations: expected an integer in [0, 1000000], got -5"},
       {"nan_literal", replace(g, R"("alpha": 0.001)", R"("alpha": NaN)"), "not valid JSON"},
       {"huge_number", replace(g, R"("alpha": 0.001)", R"("alpha": 1e999)"), "not valid JSON: number overflow parsing '1e999'"},
+      {"stage_controls_per_frame", replace(g, R"("max_evaluations": 5)", R"("schedule": [{"substeps": 1, "controls": {"kind": "initial_rigid_velocity"}}, {"substeps": 1}])"), "/optimizer/schedule/0/controls: a stage's own controls only with the scene's controls.kind \"initial_velocity\""},
+      {"stage_controls_last", replace(replace(g, R"("kind": "per_frame")", R"("kind": "initial_velocity")"), R"("max_evaluations": 5)", R"("schedule": [{"substeps": 1, "controls": {"kind": "initial_rigid_velocity"}}])"), "/optimizer/schedule/0/controls: the last stage uses the scene's controls (no \"controls\")"},
+      {"stage_controls_kind", replace(replace(g, R"("kind": "per_frame")", R"("kind": "initial_velocity")"), R"("max_evaluations": 5)", R"("schedule": [{"substeps": 1, "controls": {"kind": "per_step"}}, {"substeps": 1}])"), "/optimizer/schedule/0/controls/kind: expected one of \"initial_velocity\", \"initial_rigid_velocity\", got \"per_step\""},
       {"seed_type", replace(g, R"("time")", R"("seed": "one", "time")"), "/seed: expected an integer, got string"},
   };
 }
