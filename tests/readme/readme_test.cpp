@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -130,6 +131,72 @@ TEST(Readme, AHandEditedValueOrAnUnclosedMarkerFails) {
   EXPECT_THROW(generated_parts("a <!--gen:echo 1-->1 and no close"), std::runtime_error);
   EXPECT_THROW(generated_parts("<!--gen:scripts/result x.csv y --fmt %d-->1<!--/gen-->"), std::runtime_error);
   EXPECT_EQ(regenerated("x <!--gen:echo 2-->1<!--/gen--> y"), "x <!--gen:echo 2-->2<!--/gen--> y");
+}
+
+// One CSV record's fields (RFC 4180 quoting: "a, ""b""" is one field).
+std::vector<std::string> csv_fields(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') out.back() += '"', ++i;
+    else if (c == '"') quoted = !quoted;
+    else if (c == ',' && !quoted) out.emplace_back();
+    else out.back() += c;
+  }
+  return out;
+}
+
+// What is wrong with the stamps of the results under `dir` (its stamps.csv: file,date,commit,machine,
+// load_1min,load,note): a file without a row, a row without date, commit, machine or load, a row for a
+// file that is not there. README.md and stamps.csv themselves need none.
+std::vector<std::string> stamp_problems(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> out;
+  std::ifstream in(dir / "stamps.csv");
+  std::string line;
+  std::map<std::string, std::vector<std::string>> rows;
+  if (!std::getline(in, line) || line != "file,date,commit,machine,load_1min,load,note")
+    return {(dir / "stamps.csv").string() + ": missing or without its header"};
+  while (std::getline(in, line)) {
+    auto f = csv_fields(line);
+    if (f.size() != 7) {
+      out.push_back("stamps.csv: a row of " + std::to_string(f.size()) + " fields: " + line);
+      continue;
+    }
+    for (int k : {1, 2, 3, 5})
+      if (f[size_t(k)].empty()) out.push_back("stamps.csv: " + f[0] + " has no " + csv_fields("file,date,commit,machine,load_1min,load")[size_t(k)]);
+    if (!fs::is_regular_file(dir / f[0])) out.push_back("stamps.csv: " + f[0] + " is not there");
+    rows[f[0]] = f;
+  }
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (!e.is_regular_file()) continue;
+    const std::string rel = fs::relative(e.path(), dir).generic_string();
+    if (rel != "README.md" && rel != "stamps.csv" && !rows.count(rel)) out.push_back(rel + " has no stamp in stamps.csv");
+  }
+  return out;
+}
+
+TEST(Readme, EveryCommittedResultIsStampedWithMachineCommitAndDate) {
+  const auto problems = stamp_problems(KEYFRAME_SOURCE_DIR "/tests/results");
+  for (const std::string& p : problems) ADD_FAILURE() << "tests/results/" << p << " (scripts/stamp FILE adds a row)";
+}
+
+TEST(Readme, AnUnstampedResultOrAStampForNoFileFails) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("keyframe_stamps_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" + std::to_string(std::rand()));
+  fs::create_directories(dir / "runs/a");
+  std::ofstream(dir / "runs/a/report.json") << "{}";
+  std::ofstream(dir / "b.csv") << "x\n1\n";
+  std::ofstream(dir / "stamps.csv") << "file,date,commit,machine,load_1min,load,note\n"
+                                       "b.csv,2026-01-01,abc1234,\"vm: 2 CPU, 24 GB\",0.1,idle,\n";
+  EXPECT_TRUE(stamp_problems(dir).size() == 1 && stamp_problems(dir)[0] == "runs/a/report.json has no stamp in stamps.csv");
+  std::ofstream(dir / "stamps.csv", std::ios::app) << "runs/a/report.json,2026-01-01,,vm,0.1,idle,\ngone.csv,2026-01-01,abc,vm,,idle,\n";
+  const auto problems = stamp_problems(dir);
+  EXPECT_EQ(problems.size(), 2u);
+  EXPECT_NE(std::find(problems.begin(), problems.end(), "stamps.csv: runs/a/report.json has no commit"), problems.end());
+  EXPECT_NE(std::find(problems.begin(), problems.end(), "stamps.csv: gone.csv is not there"), problems.end());
+  fs::remove_all(dir);
 }
 
 }  // namespace
