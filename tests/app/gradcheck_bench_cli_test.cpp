@@ -97,5 +97,36 @@ TEST_F(GradcheckBenchCli, TinyFlockBenchWritesItsCsvPlotAndSummary) {
   EXPECT_TRUE(std::isfinite(summary["flock"]["gradient_exponent"].get<double>())) << summary.dump();
 }
 
+// The solver sweep on two tiny sheets: one column triple per solver and thread count, every cell measured
+// (the sheets are small enough for the direct solve), and names outside the list refused.
+TEST_F(GradcheckBenchCli, TinySolverBenchHasAColumnPerSolverAndRefusesUnknownNames) {
+  const auto r = run_keyframe(
+      "bench --only solver --solver-resolutions 6,8 --solvers pcg,mg-1e-6,auto,direct --threads 1 --solver-frames 1 "
+      "--blender-n 0 --out s",
+      dir_);
+  ASSERT_EQ(r.code, kExitOk) << r.output;
+  std::ifstream csv(dir_ / "s/solver.csv");
+  std::string header, line;
+  std::getline(csv, header);
+  EXPECT_EQ(header,
+            "n,particles,pcg_t1_forward_ms,pcg_t1_gradient_ms,pcg_t1_gradient_over_forward,mg-1e-6_t1_forward_ms,"
+            "mg-1e-6_t1_gradient_ms,mg-1e-6_t1_gradient_over_forward,auto_t1_forward_ms,auto_t1_gradient_ms,"
+            "auto_t1_gradient_over_forward,direct_t1_forward_ms,direct_t1_gradient_ms,direct_t1_gradient_over_forward");
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    ++rows;
+    std::stringstream ss(line);
+    std::string cell;
+    for (int c = 0; std::getline(ss, cell, ','); ++c)
+      if (c >= 2) EXPECT_GT(std::stod(cell), 0) << line;
+  }
+  EXPECT_EQ(rows, 2);
+  for (const char* bad : {"mg-2", "ilu", "pcg-x"}) {
+    const auto b = run_keyframe(std::string("bench --only solver --solvers ") + bad + " --out t", dir_);
+    EXPECT_NE(b.code, kExitOk) << bad;
+    EXPECT_NE(b.output.find("expected pcg, mg, auto"), std::string::npos) << b.output;
+  }
+}
+
 }  // namespace
 }  // namespace kf
