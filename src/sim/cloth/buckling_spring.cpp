@@ -146,6 +146,33 @@ void spring_force_and_definite_jacobian(const BucklingSpring& sp, const VecX& x,
   B = dT * nn + t * (Mat3::Identity() - nn);
 }
 
+void spring_jacobian_and_definite_derivative(const BucklingSpring& sp, const VecX& x, bool derivative, const Vec3& p,
+                                             const Vec3& q, Mat3& B, Vec3& dpq) {
+  dpq.setZero();
+  if (sp.rest == 0) {
+    B = sp.k * Mat3::Identity();
+    return;
+  }
+  const Vec3 d = seg(x, sp.b) - seg(x, sp.a);
+  const double s = d.norm();
+  double T, dT, d2T;
+  spring_tension(sp, s, T, dT, d2T);
+  if (s <= kDegenerate * sp.rest) {
+    B = dT * Mat3::Identity();
+    return;
+  }
+  const Vec3 n = d / s;
+  const Mat3 nn = n * n.transpose();
+  double t, dt;
+  transverse_stiffness(sp, s, T, dT, /*definite=*/false, t, dt);
+  B = dT * nn + t * (Mat3::Identity() - nn);
+  if (!derivative) return;
+  transverse_stiffness(sp, s, T, dT, /*definite=*/true, t, dt);
+  const double pn = p.dot(n), qn = q.dot(n);
+  const Vec3 dpn = (p - pn * n) / s, dqn = (q - qn * n) / s;
+  dpq = ((d2T - dt) * pn * qn + dt * p.dot(q)) * n + (dT - t) * (qn * dpn + pn * dqn);
+}
+
 Vec3 spring_jacobian_derivative(const BucklingSpring& sp, const VecX& x, bool definite, const Vec3& p, const Vec3& q) {
   if (sp.rest == 0) return Vec3::Zero();
   const Vec3 d = seg(x, sp.b) - seg(x, sp.a);

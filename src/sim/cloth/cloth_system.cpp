@@ -409,11 +409,14 @@ void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v,
     for (int k = r.begin(); k < r.end(); ++k) {
       const BucklingSpring& s = springs_[k];
       const Vec3 dw = seg(w, s.b) - seg(w, s.a);
-      Mat3 G = spring_jacobian(s, x, /*definite=*/false);
+      const bool derivative = exact && dw.squaredNorm() > 0;
+      Mat3 G;
+      Vec3 dK;
+      spring_jacobian_and_definite_derivative(s, x, derivative, dw, seg(c_, s.b) - seg(c_, s.a), G, dK);
       if (k < damped_) G += damping_jacobian_x(s, spec_.damping, x, v);
       Vec3 t = G.transpose() * dw;
-      if (exact && dw.squaredNorm() > 0) {
-        t += h * spring_jacobian_derivative(s, x, /*definite=*/true, dw, seg(c_, s.b) - seg(c_, s.a));
+      if (derivative) {
+        t += h * dK;
         if (k < damped_) t += damping_jacobian_v_derivative(s, spec_.damping, x, dw, seg(dv, s.b) - seg(dv, s.a));
       }
       spring_f_[k] = t;

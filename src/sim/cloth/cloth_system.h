@@ -1,7 +1,7 @@
 #pragma once
 // Choi-Ko cloth stepped by linearised backward Euler (design §4), with two adjoints.
 //
-// Forward:  A dv = b, A = M - h D - h^2 K, b = h (f + h K v + u), solved by PCG (IC(0)) with pinned
+// Forward:  A dv = b, A = M - h D - h^2 K, b = h (f + h K v + u), solved by PCG (IC(0) or multigrid) with pinned
 //           particles filtered out (Baraff-Witkin); v1 = v + dv, x1 = x + h v1. K is the springs'
 //           definite stiffness (compressive transverse part dropped) plus the colliders' normal
 //           stiffness, D the spring damping and air drag (the non-symmetric position derivative of spring
