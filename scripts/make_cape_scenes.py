@@ -22,6 +22,7 @@ BLEND_FROM = 34      # A's frame the blend starts from (9 frames after the landi
 CHARACTER = "../assets/character/BCN_Epileptic.X"
 BODY = {"thickness": 0.012, "stiffness": 2000, "search": 0.06}
 SELF = {"enabled": True, "thickness": 0.015, "stiffness": 100}
+CAMERA_A = {"eye": [2.9, 2.1, -3.5], "target": [0, 0.9, 0], "fov": 50}  # the ledge in view
 CAMERA = {"eye": [1.9, 1.0, -2.3], "target": [0, 0.3, 0], "fov": 50}
 
 
@@ -65,7 +66,7 @@ def scene_a(frames, grid=(16, 26)):
     keys, _ = fall_keys()
     root = {"pivot": [0, -1.024, 0], "axis": [1, 0, 0], "keys": keys}
     return {"time": {"fps": FPS, "substeps": 2, "frames": frames}, "cloth": cloth(-0.43 + LEDGE, *grid),
-            "character": character([[0, 0.0]], {"root": root}), "render": {"camera": CAMERA}}
+            "character": character([[0, 0.0]], {"root": root}), "render": {"camera": CAMERA_A}}
 
 
 def scene_b(frames, end_seconds, grid=(16, 26)):
