@@ -347,11 +347,13 @@ void build_cloth(const Scene& scene, const Trajectory& traj, int f, double scale
     }
   for (const auto& c : scene.cloth->colliders) add_collider(m, c.shape, rs.collider_color);
   // Targets of the keyframes still to come, small beside their own spacing so a sheet of targets does
-  // not hide the cloth that reaches it.
+  // not hide the cloth that reaches it. A blend's end target (a whole other take's cape) is drawn at its
+  // own frame only: over the cape in every frame it would hide the blend.
   size_t markers = 0;
   for (const auto& o : scene.objectives) {
     const auto* position = std::get_if<PositionKeyframe>(&o.kind);
     if (!position || o.frame < f || position->targets.empty()) continue;
+    if (o.source == ObjectiveSource::kEndTarget && o.frame != f) continue;
     const std::vector<Vec3>& targets = position->targets;
     Bounds tb;
     for (const Vec3& q : targets) tb.add(q);

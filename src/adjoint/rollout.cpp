@@ -1,5 +1,7 @@
 #include "adjoint/rollout.h"
 
+#include <algorithm>
+
 namespace kf {
 
 Trajectory frames_of(const Rollout& r, const TimeSpec& t, int particles) {
@@ -97,8 +99,9 @@ double cost_value(const StateCost& cost, const Rollout& r) {
 }
 
 void backward(System& sys, const Rollout& r, const StepControl& u, const StateCost& cost,
-              const StepControlGradient& du, VecX& dx0, VecX& dv0) {
+              const StepControlGradient& du, VecX& dx0, VecX& dv0, int first) {
   const int N = r.steps(), dof = int(r.x[0].size());
+  first = std::clamp(first, 0, N);
   const int every = r.every > 0 ? r.every : N + 1;
   VecX xhat = VecX::Zero(dof), vhat = VecX::Zero(dof), xhat_prev(dof), vhat_prev(dof), uhat(dof);
   if (cost.active(N)) cost.eval(N, r.x[N], r.v[N], xhat, vhat);
@@ -109,7 +112,7 @@ void backward(System& sys, const Rollout& r, const StepControl& u, const StateCo
   std::vector<std::unique_ptr<StepRecord>> seg_tape;
   if (r.every > 0) ensure_tape(sys, seg_tape, every);
   const int last_start = r.every > 0 ? ((N - 1) / every) * every : 0;
-  for (int k = last_start; k >= 0; k -= every) {
+  for (int k = last_start; k >= 0 && std::min(k + every, N) > first; k -= every) {
     const int e = std::min(k + every, N);
     auto state_x = [&](int n) -> const VecX& { return r.every > 0 ? seg_x[n - k] : r.x[n]; };
     auto state_v = [&](int n) -> const VecX& { return r.every > 0 ? seg_v[n - k] : r.v[n]; };
@@ -123,7 +126,7 @@ void backward(System& sys, const Rollout& r, const StepControl& u, const StateCo
       for (int n = k; n < e; ++n)
         sys.step(n, seg_x[n - k], seg_v[n - k], u(n), seg_x[n - k + 1], seg_v[n - k + 1], *seg_tape[n - k]);
     }
-    for (int n = e - 1; n >= k; --n) {
+    for (int n = e - 1; n >= std::max(k, first); --n) {
       if (xhat.isZero(0.0) && vhat.isZero(0.0)) {
         // After the last keyframe (a sheet landing, say) the adjoint is exactly zero and the step's
         // adjoint linear in it: skip its solve.

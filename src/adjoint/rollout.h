@@ -68,10 +68,12 @@ bool simulate(System& sys, const VecX& x0, const VecX& v0, const std::vector<Vec
 // Sum of the cost over the rollout's states (every active step must be kept).
 double cost_value(const StateCost& cost, const Rollout& r);
 
-// Adjoint pass over a successful rollout: dphi/du_n to `du` for n = N-1 .. 0, and dx0, dv0 =
-// dphi/dx_0, dphi/dv_0. Checkpointed rollouts are recomputed segment by segment (this runs sys.step).
+// Adjoint pass over a successful rollout: dphi/du_n to `du` for n = N-1 .. first, and dx0, dv0 =
+// dphi/dx_first, dphi/dv_first (first = 0: the initial state's). Checkpointed rollouts are recomputed
+// segment by segment (this runs sys.step). A `first` above 0 skips the steps before it: their forces are
+// not controls and the start state is given.
 void backward(System& sys, const Rollout& r, const StepControl& u, const StateCost& cost,
-              const StepControlGradient& du, VecX& dx0, VecX& dv0);
+              const StepControlGradient& du, VecX& dx0, VecX& dv0, int first = 0);
 // The same with per-step forces U and gradients dU (resized to N).
 void backward(System& sys, const Rollout& r, const std::vector<VecX>& U, const StateCost& cost,
               std::vector<VecX>& dU, VecX& dx0, VecX& dv0);

@@ -13,7 +13,9 @@ Controls::Controls(const ControlSpec& spec, const TimeSpec& time, int particles,
       particles_(particles),
       h_(time.h()), v0_scene_(v0_scene) {
   comps_ = planar ? std::vector<int>{0, 2} : std::vector<int>{0, 1, 2};
-  blocks_ = kind_ == ControlKind::kPerStep ? steps_ : kind_ == ControlKind::kPerFrame ? time.frames : 1;
+  const int from = std::clamp(spec.from_frame, 0, std::max(0, time.frames - 1));
+  first_step_ = kind_ == ControlKind::kPerStep || kind_ == ControlKind::kPerFrame ? from * substeps_ : 0;
+  blocks_ = kind_ == ControlKind::kPerStep ? steps_ - first_step_ : kind_ == ControlKind::kPerFrame ? time.frames - from : 1;
   if (kind_ == ControlKind::kInitialRigidVelocity) {
     rigid_ = true;
     kind_ = ControlKind::kInitialVelocity;  // everywhere else it behaves as initial-velocity control
@@ -23,6 +25,11 @@ Controls::Controls(const ControlSpec& spec, const TimeSpec& time, int particles,
     arms_.resize(3 * particles_);
     for (int i = 0; i < particles_; ++i) arms_.segment<3>(3 * i) = x0_scene.segment<3>(3 * i) - c;
   }
+}
+
+int Controls::block_of(int n) const {
+  if (n < first_step_) return -1;
+  return kind_ == ControlKind::kPerStep ? n - first_step_ : (n - first_step_) / substeps_;
 }
 
 void Controls::rigid_velocity(const VecX& z, VecX& v0) const {
@@ -71,8 +78,8 @@ void Controls::expand(const VecX& z, VecX& v0, std::vector<VecX>& U) const {
       for (int c = 0; c < nc; ++c) v0[3 * i + comps_[c]] = z[i * nc + c];
     return;
   }
-  for (int n = 0; n < steps_; ++n) {
-    const int b = kind_ == ControlKind::kPerStep ? n : n / substeps_;
+  for (int n = first_step_; n < steps_; ++n) {
+    const int b = block_of(n);
     for (int i = 0; i < particles_; ++i)
       for (int c = 0; c < nc; ++c) U[n][3 * i + comps_[c]] = z[b * stride + i * nc + c];
   }
@@ -87,8 +94,8 @@ void Controls::gather(const std::vector<VecX>& dU, const VecX& dv0, VecX& dz) co
       for (int c = 0; c < nc; ++c) dz[i * nc + c] = dv0[3 * i + comps_[c]];
     return;
   }
-  for (int n = 0; n < steps_; ++n) {
-    const int b = kind_ == ControlKind::kPerStep ? n : n / substeps_;
+  for (int n = first_step_; n < steps_; ++n) {
+    const int b = block_of(n);
     for (int i = 0; i < particles_; ++i)
       for (int c = 0; c < nc; ++c) dz[b * stride + i * nc + c] += dU[n][3 * i + comps_[c]];
   }
@@ -98,9 +105,10 @@ VecX Controls::remap_from(const VecX& z, const TimeSpec& from) const {
   if (kind_ != ControlKind::kPerStep || from.substeps == substeps_) return z;
   const int stride = particles_ * int(comps_.size());
   VecX out(size());
-  for (int n = 0; n < steps_; ++n) {
+  const int from_first = first_step_ / substeps_ * from.substeps;
+  for (int n = first_step_; n < steps_; ++n) {
     const int m = std::min(from.steps() - 1, int((long(n) * from.substeps) / substeps_));
-    out.segment(long(n) * stride, stride) = z.segment(long(m) * stride, stride);
+    out.segment(long(n - first_step_) * stride, stride) = z.segment(long(m - from_first) * stride, stride);
   }
   return out;
 }
@@ -109,16 +117,16 @@ void Controls::force_at(const VecX& z, int n, VecX& u) const {
   const int nc = int(comps_.size()), dof = 3 * particles_, stride = particles_ * nc;
   if (u.size() != dof) u.resize(dof);
   u.setZero();
-  if (kind_ == ControlKind::kInitialVelocity) return;
-  const int b = kind_ == ControlKind::kPerStep ? n : n / substeps_;
+  const int b = block_of(n);
+  if (kind_ == ControlKind::kInitialVelocity || b < 0) return;
   for (int i = 0; i < particles_; ++i)
     for (int c = 0; c < nc; ++c) u[3 * i + comps_[c]] = z[b * stride + i * nc + c];
 }
 
 void Controls::add_step_gradient(int n, const VecX& uhat, VecX& dz) const {
-  if (kind_ == ControlKind::kInitialVelocity) return;
+  const int b = block_of(n);
+  if (kind_ == ControlKind::kInitialVelocity || b < 0) return;
   const int nc = int(comps_.size()), stride = particles_ * nc;
-  const int b = kind_ == ControlKind::kPerStep ? n : n / substeps_;
   for (int i = 0; i < particles_; ++i)
     for (int c = 0; c < nc; ++c) dz[b * stride + i * nc + c] += uhat[3 * i + comps_[c]];
 }

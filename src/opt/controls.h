@@ -32,6 +32,8 @@ class Controls {
   // rule of one step's dphi/du_n (3p) added into dz (size()). Zero / nothing for initial velocities.
   void force_at(const VecX& z, int n, VecX& u) const;
   void add_step_gradient(int n, const VecX& uhat, VecX& dz) const;
+  // The first step whose force is a control (0 for initial-velocity controls, which need the whole adjoint).
+  int first_step() const { return kind_ == ControlKind::kInitialVelocity ? 0 : first_step_; }
   // The initial velocities z gives (3p).
   void initial_velocity(const VecX& z, VecX& v0) const;
   // The per-particle initial-velocity controls (size()) that give v0 (3p), e.g. a rigid throw's velocities
@@ -48,7 +50,10 @@ class Controls {
   double alpha_;
   int steps_, substeps_, frames_, particles_, blocks_;
   double h_;
+  int first_step_ = 0;       // the first step with a force (controls' from_frame)
   std::vector<int> comps_;  // which of x, y, z are controlled
+  // The force block step n reads (-1: before first_step_, no force).
+  int block_of(int n) const;
   VecX v0_scene_;
   // Rigid initial velocity: z = (Δv, ω), v0_i = v0_scene_i + Δv + ω × (x0_i − c); arms_ holds x0_i − c.
   bool rigid_ = false;

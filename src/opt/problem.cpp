@@ -61,7 +61,7 @@ double Problem::evaluate(const VecX& z, VecX* grad) {
     if (ok && grad) {
       grad->setZero(size());
       backward(sys_, rollout_, u_at, *this, [&](int n, const VecX& uhat) { controls_.add_step_gradient(n, uhat, *grad); },
-               dx0_, dv0_);
+               dx0_, dv0_, controls_.first_step());
       controls_.gather_initial_velocity(dv0_, *grad);
       *grad += dz_effort;
       ok = grad->allFinite();

@@ -79,6 +79,9 @@ inline const char* control_kind_name(ControlKind k) {
 struct ControlSpec {
   ControlKind kind = ControlKind::kPerStep;
   double alpha = 1e-4;  // weight of the control effort ½α‖u‖²
+  // Forces act from this frame on (per_step / per_frame); earlier steps are uncontrolled. A blend whose
+  // start flails against the body is steered over its last frames, where the gradient stays finite.
+  int from_frame = 0;
 };
 
 // One stage of continuation: optimise at this many substeps per frame, optionally over a coarser control

@@ -101,8 +101,8 @@ ObjectiveSpec parse_objective(Block b, const Scene& s) {
   return o;
 }
 
-// `only_initial`: a schedule stage's controls, limited to the two initial-velocity kinds.
-ControlSpec parse_controls(Block b, bool only_initial = false) {
+// `only_initial`: a schedule stage's controls, limited to the two initial-velocity kinds; frames: the scene's.
+ControlSpec parse_controls(Block b, bool only_initial = false, int frames = 1) {
   ControlSpec c;
   if (only_initial) c.kind = ControlKind::kInitialRigidVelocity;
   std::vector<ControlKind> kinds = {ControlKind::kInitialVelocity, ControlKind::kInitialRigidVelocity};
@@ -113,6 +113,7 @@ ControlSpec parse_controls(Block b, bool only_initial = false) {
   for (ControlKind k : kinds)
     if (kind == control_kind_name(k)) c.kind = k;
   c.alpha = b.number("alpha", c.alpha, 0.0, 1e6);
+  if (!only_initial) c.from_frame = b.integer("from_frame", 0, 0, std::max(0, frames - 1));
   b.finish();
   return c;
 }
@@ -181,7 +182,7 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& file) {
   }
   if (root.has("character")) s.character = parse_character_spec(root.child("character"), s);
   for (Block& b : root.array("objectives")) s.objectives.push_back(parse_objective(std::move(b), s));
-  s.controls = parse_controls(root.child("controls"));
+  s.controls = parse_controls(root.child("controls"), false, s.time.frames);
   s.optimizer = parse_optimizer(root.child("optimizer"), s.controls);
   {
     Block b = root.child("render");

@@ -10,7 +10,7 @@ namespace kf {
 namespace {
 
 // A cloth-typed scene (3-D controls) whose particle count matches the toy system: 2 x 2 = 4 particles.
-Scene toy_scene(const std::string& controls, int substeps) {
+Scene toy_scene(const std::string& controls, int substeps, int from_frame = 0) {
   const std::string text = R"({
     "time": {"fps": 10, "substeps": )" + std::to_string(substeps) + R"(, "frames": 12},
     "cloth": {"nx": 2, "ny": 2},
@@ -20,7 +20,7 @@ Scene toy_scene(const std::string& controls, int substeps) {
       {"type": "center_of_mass", "frame": 12, "target": [1.0, 0.5, -0.5], "weight": 2},
       {"type": "arch", "frame": 9, "axis_point": [1, 0, 0], "axis": [0, 0, 1], "radius": 1.2}
     ],
-    "controls": {"kind": ")" + controls + R"(", "alpha": 0.01}
+    "controls": {"kind": ")" + controls + R"(", "alpha": 0.01, "from_frame": )" + std::to_string(from_frame) + R"(}
   })";
   return parse_scene(text, "toy.json");
 }
@@ -56,6 +56,45 @@ TEST(Problem, PerFrameForcesAreHeldOverSubsteps) {
   ASSERT_EQ(U.size(), 48u);
   EXPECT_EQ(U[4], U[7]);
   EXPECT_NE(U[3], U[4]);
+}
+
+// Forces from frame 5 on: none before, the gradient (whose adjoint pass stops at step 5 * substeps) still
+// exact, per-step forces remapped between substep counts within the window.
+TEST(Problem, ForcesFromAFrameOnAreZeroBeforeItAndTheirGradientIsExact) {
+  for (const std::string kind : {"per_frame", "per_step"}) {
+    Scene scene = toy_scene(kind, 3, 5);
+    test::ToySystem sys(4, scene.time.h());
+    Problem problem(scene, scene.time, sys);
+    const int blocks = kind == "per_frame" ? 12 - 5 : 3 * (12 - 5);
+    ASSERT_EQ(problem.size(), blocks * 4 * 3) << kind;
+    Controls c(scene.controls, scene.time, 4, false, VecX::Zero(12), VecX::Zero(12));
+    VecX u;
+    c.force_at(VecX::Ones(c.size()), 14, u);
+    EXPECT_TRUE(u.isZero(0.0)) << kind;
+    c.force_at(VecX::Ones(c.size()), 15, u);
+    EXPECT_TRUE(u.isOnes(0.0)) << kind;
+    VecX z = problem.initial_guess() + 0.3 * VecX::Random(problem.size());
+    const GradcheckResult r = gradcheck(problem, z, {.samples = 40, .eps = 1e-3, .seed = 5});
+    ASSERT_GT(r.grad_norm, 1e-3) << kind;
+    EXPECT_LT(r.max_rel_error, 1e-6) << kind << ": cosine " << r.cosine;
+  }
+  TimeSpec fine;
+  fine.fps = 10, fine.substeps = 4, fine.frames = 12;
+  TimeSpec coarse = fine;
+  coarse.substeps = 2;
+  ControlSpec spec;
+  spec.from_frame = 5;
+  const Controls cf(spec, fine, 1, false, VecX::Zero(3), VecX::Zero(3));
+  const Controls cc(spec, coarse, 1, false, VecX::Zero(3), VecX::Zero(3));
+  const VecX zc = VecX::LinSpaced(cc.size(), 1, double(cc.size()));
+  const VecX zf = cf.remap_from(zc, coarse);
+  ASSERT_EQ(zf.size(), cf.size());
+  VecX uf, uc;
+  for (int n = 20; n < 48; ++n) {  // fine step n lies in coarse step n / 2
+    cf.force_at(zf, n, uf);
+    cc.force_at(zc, n / 2, uc);
+    EXPECT_EQ(uf, uc) << "step " << n;
+  }
 }
 
 TEST(Problem, PlanarControlsHaveNoVerticalComponent) {
