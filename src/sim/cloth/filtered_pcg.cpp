@@ -36,6 +36,10 @@ void FilteredPcg::prepare(const BlockSparse3& A, const std::vector<char>& free) 
     ic_ok_ = factor_ic(A, free);
     if (ic_ok_) return;
   }
+  prepare_block_jacobi(A, free);
+}
+
+void FilteredPcg::prepare_block_jacobi(const BlockSparse3& A, const std::vector<char>& free) {
   tbb::parallel_for(tbb::blocked_range<int>(0, A.block_rows(), 512), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i)
       inv_diag_[i] = free[i] ? Mat3(A.block(A.diag_slot(i)).inverse()) : Mat3::Zero();
@@ -144,6 +148,20 @@ void FilteredPcg::precondition(const BlockSparse3& A, const std::vector<char>& f
 
 PcgResult FilteredPcg::solve(const BlockSparse3& A, const std::vector<char>& free, const VecX& b, VecX& x,
                              double tol, int max_iterations, bool warm) {
+  PcgResult res = solve_once(A, free, b, x, tol, max_iterations, warm);
+  if (res.converged || !mg_ok_) return res;
+  // A V-cycle that stopped being positive definite (a coarse level's smoother diverging) breaks CG; the
+  // step is solved again, from zero, with block Jacobi (deterministic: it depends on this step alone).
+  mg_ok_ = false;
+  prepare_block_jacobi(A, free);
+  const int spent = res.iterations;
+  res = solve_once(A, free, b, x, tol, max_iterations, false);
+  res.iterations += spent;
+  return res;
+}
+
+PcgResult FilteredPcg::solve_once(const BlockSparse3& A, const std::vector<char>& free, const VecX& b, VecX& x,
+                                  double tol, int max_iterations, bool warm) {
   PcgResult res;
   if (!warm)
     for (int i = 0; i < int(free.size()); ++i)

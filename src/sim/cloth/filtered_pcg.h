@@ -4,7 +4,7 @@
 // Preconditioner: a multigrid V-cycle over the sheet's grid (GridMultigrid), block incomplete Cholesky
 // IC(0) on the free set (the factor keeps A's block pattern), or the inverse of each free particle's 3x3
 // diagonal block (block Jacobi). Multigrid and IC(0) fall back to block Jacobi for a step whose matrix
-// they cannot use (a pivot that is not positive definite).
+// they cannot use (a pivot that is not positive definite; for multigrid also a CG that breaks down).
 // Reductions and triangular solves are serial over a fixed order, so results do not depend on the thread
 // count.
 #include <vector>
@@ -41,6 +41,9 @@ class FilteredPcg {
                   int max_iterations, bool warm = false);
 
  private:
+  PcgResult solve_once(const BlockSparse3& A, const std::vector<char>& free, const VecX& b, VecX& x, double tol,
+                       int max_iterations, bool warm);
+  void prepare_block_jacobi(const BlockSparse3& A, const std::vector<char>& free);
   void filter(const std::vector<char>& free, VecX& y) const;
   void precondition(const BlockSparse3& A, const std::vector<char>& free, const VecX& r, VecX& z);
   bool factor_ic(const BlockSparse3& A, const std::vector<char>& free);
