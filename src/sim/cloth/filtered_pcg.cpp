@@ -105,44 +105,23 @@ void FilteredPcg::precondition(const BlockSparse3& A, const std::vector<char>& f
     for (int i = 0; i < n; ++i) seg(z, i).noalias() = inv_diag_[i] * seg(r, i);
     return;
   }
-  // z = L^-T L^-1 r: forward substitution by rows, then backward by columns of L^T. L's blocks in pinned
-  // columns are zero and pinned entries of z stay zero, so only pinned rows need skipping. In scalars: the
-  // serial triangular solves are the step's longest chain.
-  double* zd = z.data();
+  // z = L^-T L^-1 r: forward substitution by rows, then backward by columns of L^T.
   for (int i = 0; i < n; ++i) {
-    double* zi = zd + 3 * i;
     if (!free[i]) {
-      zi[0] = zi[1] = zi[2] = 0;
+      seg(z, i).setZero();
       continue;
     }
-    double y0 = r[3 * i], y1 = r[3 * i + 1], y2 = r[3 * i + 2];
-    for (int k = A.row_start(i); k < A.diag_slot(i); ++k) {
-      const double* l = lower_[k].data();  // column-major
-      const double* zj = zd + 3 * A.col(k);
-      y0 -= l[0] * zj[0] + l[3] * zj[1] + l[6] * zj[2];
-      y1 -= l[1] * zj[0] + l[4] * zj[1] + l[7] * zj[2];
-      y2 -= l[2] * zj[0] + l[5] * zj[1] + l[8] * zj[2];
-    }
-    const double* d = inv_diag_[i].data();  // lower triangular
-    zi[0] = d[0] * y0;
-    zi[1] = d[1] * y0 + d[4] * y1;
-    zi[2] = d[2] * y0 + d[5] * y1 + d[8] * y2;
+    Vec3 y = seg(r, i);
+    for (int k = A.row_start(i); k < A.diag_slot(i); ++k)
+      if (free[A.col(k)]) y.noalias() -= lower_[k] * seg(z, A.col(k));
+    seg(z, i).noalias() = inv_diag_[i] * y;
   }
   for (int i = n - 1; i >= 0; --i) {
     if (!free[i]) continue;
-    double* zi = zd + 3 * i;
-    const double* d = inv_diag_[i].data();  // z_i = L_ii^-T z_i (upper triangular)
-    const double z0 = d[0] * zi[0] + d[1] * zi[1] + d[2] * zi[2], z1 = d[4] * zi[1] + d[5] * zi[2], z2 = d[8] * zi[2];
-    zi[0] = z0;
-    zi[1] = z1;
-    zi[2] = z2;
-    for (int k = A.row_start(i); k < A.diag_slot(i); ++k) {
-      const double* l = lower_[k].data();
-      double* zj = zd + 3 * A.col(k);
-      zj[0] -= l[0] * z0 + l[1] * z1 + l[2] * z2;
-      zj[1] -= l[3] * z0 + l[4] * z1 + l[5] * z2;
-      zj[2] -= l[6] * z0 + l[7] * z1 + l[8] * z2;
-    }
+    const Vec3 zi = inv_diag_[i].transpose() * seg(z, i);
+    seg(z, i) = zi;
+    for (int k = A.row_start(i); k < A.diag_slot(i); ++k)
+      if (free[A.col(k)]) seg(z, A.col(k)).noalias() -= lower_[k].transpose() * zi;
   }
 }
 
