@@ -248,7 +248,10 @@ Vec3 ClothSystem::stiffness_times_velocity(int i, const VecX& v) const {
 }
 
 ClothSystem::Energy ClothSystem::energy(int n, const VecX& x, const VecX& v) const {
-  Energy e = state_energy(x, v);
+  return with_contact_energy(n, x, state_energy(x, v));
+}
+
+ClothSystem::Energy ClothSystem::with_contact_energy(int n, const VecX& x, Energy e) const {
   for (int i = 0; i < p_; ++i)
     for (const auto& c : colliders_) e.contact += c->energy(n, seg(x, i));
   return e;
@@ -280,11 +283,8 @@ ClothSystem::Energy ClothSystem::state_energy(const VecX& x, const VecX& v) cons
 // so a caller that steps from anywhere else gets a fresh sum; the contact part depends on n and is
 // always recomputed.
 ClothSystem::Energy ClothSystem::energy_at_start(int n, const VecX& x, const VecX& v) {
-  if (!(energy_x_.size() == x.size() && energy_x_ == x && energy_v_ == v)) return energy(n, x, v);
-  Energy e = cached_energy_;
-  for (int i = 0; i < p_; ++i)
-    for (const auto& c : colliders_) e.contact += c->energy(n, seg(x, i));
-  return e;
+  const bool cached = energy_x_.size() == x.size() && energy_x_ == x && energy_v_ == v;
+  return with_contact_energy(n, x, cached ? cached_energy_ : state_energy(x, v));
 }
 
 void ClothSystem::remember_energy(const VecX& x, const VecX& v, const Energy& e) {
@@ -449,20 +449,18 @@ void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v,
   uhat += h * w;
 }
 
-BlockSparse3 ClothSystem::block_matrix(const std::vector<Mat3>& per_spring, const std::vector<Mat3>& diagonal,
-                                       bool damped_only) const {
+BlockSparse3 ClothSystem::block_matrix(const std::vector<Mat3>& per_spring, const std::vector<Mat3>& diagonal) const {
   BlockSparse3 m = A_;
   for (int i = 0; i < p_; ++i)
     for (int k = A_.row_start(i); k < A_.row_start(i + 1); ++k) {
       const int sp = slot_spring_[k];
-      if (sp < 0) m.block(k) = diagonal[i];
-      else m.block(k) = damped_only && sp >= damped_ ? Mat3::Zero() : per_spring[sp];
+      m.block(k) = sp < 0 ? diagonal[i] : per_spring[sp];
     }
   return m;
 }
 
-SpMat ClothSystem::stiffness_matrix() const { return block_matrix(spring_K_, diag_K_, false).to_sparse(); }
-SpMat ClothSystem::damping_matrix() const { return block_matrix(spring_D_, diag_D_, true).to_sparse(); }
+SpMat ClothSystem::stiffness_matrix() const { return block_matrix(spring_K_, diag_K_).to_sparse(); }
+SpMat ClothSystem::damping_matrix() const { return block_matrix(spring_D_, diag_D_).to_sparse(); }
 
 void ClothSystem::save_step_context(int n, VecX& context) const {
   if (last_forward_n_ == n - 1) context = dv_;

@@ -125,10 +125,12 @@ class ClothSystem final : public System {
                        const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat);
   // Solves the assembled A on the free set (x: prescribed values on pins, warm start on free ones).
   PcgResult solve(const VecX& b, VecX& x, bool warm);
+  Energy with_contact_energy(int n, const VecX& x, Energy e) const;  // e plus the colliders' part at step n
   Energy energy_at_start(int n, const VecX& x, const VecX& v);
   void remember_energy(const VecX& x, const VecX& v, const Energy& e);
-  // K or D as a block matrix on A's pattern (diagnostics; allocates).
-  BlockSparse3 block_matrix(const std::vector<Mat3>& per_spring, const std::vector<Mat3>& diagonal, bool damped_only) const;
+  // K or D as a block matrix on A's pattern (diagnostics; allocates). spring_D_ stays zero for the
+  // undamped (bending) springs.
+  BlockSparse3 block_matrix(const std::vector<Mat3>& per_spring, const std::vector<Mat3>& diagonal) const;
   // Work (J) of the control u on the free particles and of the pins on their springs from x0 to x1.
   double external_work(const VecX& u, const VecX& x0, const VecX& x1) const;
 

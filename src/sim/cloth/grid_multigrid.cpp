@@ -49,6 +49,18 @@ std::vector<std::vector<std::pair<int, double>>> line_weights(int n) {
 
 }  // namespace
 
+WeightedRows WeightedRows::from(const std::vector<std::vector<std::pair<int, double>>>& rows) {
+  WeightedRows r;
+  for (const auto& row : rows) {
+    for (auto [i, w] : row) {
+      r.index.push_back(i);
+      r.w.push_back(w);
+    }
+    r.start.push_back(int(r.index.size()));
+  }
+  return r;
+}
+
 void GridMultigrid::setup(int nx, int ny, const BlockSparse3& A, const std::vector<char>& free) {
   levels_.clear();
   levels_.emplace_back();
@@ -61,43 +73,31 @@ void GridMultigrid::setup(int nx, int ny, const BlockSparse3& A, const std::vect
     const int cx = coarse_count(f.nx), cy = coarse_count(f.ny), nf = f.nx * f.ny, nc = cx * cy;
     const auto wx = line_weights(f.nx), wy = line_weights(f.ny);
     // Interpolation rows; an inactive fine node takes nothing (P's Dirichlet rows).
-    f.interp_start.assign(1, 0);
-    f.interp_node.clear();
-    f.interp_w.clear();
+    std::vector<std::vector<std::pair<int, double>>> parents(nf);
     std::vector<char> coarse_active(nc, 0);
     for (int j = 0; j < f.ny; ++j)
-      for (int i = 0; i < f.nx; ++i) {
+      for (int i = 0; i < f.nx; ++i)
         if (f.active[j * f.nx + i])
           for (auto [cj, vj] : wy[j])
             for (auto [ci, vi] : wx[i]) {
-              f.interp_node.push_back(cj * cx + ci);
-              f.interp_w.push_back(vi * vj);
+              parents[j * f.nx + i].push_back({cj * cx + ci, vi * vj});
               coarse_active[cj * cx + ci] = 1;
             }
-        f.interp_start.push_back(int(f.interp_node.size()));
-      }
+    f.interp = WeightedRows::from(parents);
+    const WeightedRows& P = f.interp;
     // Restriction: the transpose, gathered per coarse node in fine order.
     std::vector<std::vector<std::pair<int, double>>> gather(nc);
     for (int i = 0; i < nf; ++i)
-      for (int k = f.interp_start[i]; k < f.interp_start[i + 1]; ++k) gather[f.interp_node[k]].push_back({i, f.interp_w[k]});
-    f.restrict_start.assign(1, 0);
-    f.restrict_node.clear();
-    f.restrict_w.clear();
-    for (const auto& g : gather) {
-      for (auto [i, w] : g) {
-        f.restrict_node.push_back(i);
-        f.restrict_w.push_back(w);
-      }
-      f.restrict_start.push_back(int(f.restrict_node.size()));
-    }
+      for (int k = P.start[i]; k < P.start[i + 1]; ++k) gather[P.index[k]].push_back({i, P.w[k]});
+    f.restriction = WeightedRows::from(gather);
     // Coarse pattern: (I, J) wherever a fine block (i, j) links a parent of i to a parent of j.
     std::vector<std::vector<int>> cols(nc);
     for (int c = 0; c < nc; ++c) cols[c].push_back(c);
     for (int i = 0; i < nf; ++i)
       for (int s = Af.row_start(i); s < Af.row_start(i + 1); ++s) {
         const int j = Af.col(s);
-        for (int a = f.interp_start[i]; a < f.interp_start[i + 1]; ++a)
-          for (int b = f.interp_start[j]; b < f.interp_start[j + 1]; ++b) cols[f.interp_node[a]].push_back(f.interp_node[b]);
+        for (int a = P.start[i]; a < P.start[i + 1]; ++a)
+          for (int b = P.start[j]; b < P.start[j + 1]; ++b) cols[P.index[a]].push_back(P.index[b]);
       }
     Level c;
     c.nx = cx;
@@ -109,20 +109,11 @@ void GridMultigrid::setup(int nx, int ny, const BlockSparse3& A, const std::vect
     for (int i = 0; i < nf; ++i)
       for (int s = Af.row_start(i); s < Af.row_start(i + 1); ++s) {
         const int j = Af.col(s);
-        for (int a = f.interp_start[i]; a < f.interp_start[i + 1]; ++a)
-          for (int b = f.interp_start[j]; b < f.interp_start[j + 1]; ++b)
-            terms[c.A_own.find(f.interp_node[a], f.interp_node[b])].push_back({s, f.interp_w[a] * f.interp_w[b]});
+        for (int a = P.start[i]; a < P.start[i + 1]; ++a)
+          for (int b = P.start[j]; b < P.start[j + 1]; ++b)
+            terms[c.A_own.find(P.index[a], P.index[b])].push_back({s, P.w[a] * P.w[b]});
       }
-    f.galerkin_start.assign(1, 0);
-    f.galerkin_slot.clear();
-    f.galerkin_w.clear();
-    for (const auto& t : terms) {
-      for (auto [s, w] : t) {
-        f.galerkin_slot.push_back(s);
-        f.galerkin_w.push_back(w);
-      }
-      f.galerkin_start.push_back(int(f.galerkin_slot.size()));
-    }
+    f.galerkin = WeightedRows::from(terms);
     levels_.push_back(std::move(c));
   }
   for (Level& l : levels_) {
@@ -145,7 +136,8 @@ bool GridMultigrid::prepare(const BlockSparse3& A) {
     for_rows(c.nx * c.ny, [&](int I) {
       for (int s = c.A_own.row_start(I); s < c.A_own.row_start(I + 1); ++s) {
         Mat3 sum = Mat3::Zero();
-        for (int k = f.galerkin_start[s]; k < f.galerkin_start[s + 1]; ++k) sum += f.galerkin_w[k] * Af.block(f.galerkin_slot[k]);
+        const WeightedRows& G = f.galerkin;
+        for (int k = G.start[s]; k < G.start[s + 1]; ++k) sum += G.w[k] * Af.block(G.index[k]);
         c.A_own.block(s) = sum;
       }
       if (!c.active[I]) c.A_own.block(c.A_own.diag_slot(I)).setIdentity();  // a node with only pinned children
@@ -214,12 +206,14 @@ void GridMultigrid::cycle(int l, const BlockSparse3& fine) {
   Level& C = levels_[l + 1];
   for_rows(C.nx * C.ny, [&](int c) {
     Vec3 sum = Vec3::Zero();
-    for (int k = L.restrict_start[c]; k < L.restrict_start[c + 1]; ++k) sum += L.restrict_w[k] * seg(L.t, L.restrict_node[k]);
+    const WeightedRows& R = L.restriction;
+    for (int k = R.start[c]; k < R.start[c + 1]; ++k) sum += R.w[k] * seg(L.t, R.index[k]);
     seg(C.r, c) = sum;
   });
   cycle(l + 1, fine);
   for_rows(L.nx * L.ny, [&](int i) {
-    for (int k = L.interp_start[i]; k < L.interp_start[i + 1]; ++k) seg(L.e, i) += L.interp_w[k] * seg(C.e, L.interp_node[k]);
+    const WeightedRows& P = L.interp;
+    for (int k = P.start[i]; k < P.start[i + 1]; ++k) seg(L.e, i) += P.w[k] * seg(C.e, P.index[k]);
   });
   for (int s = 0; s < kSweeps; ++s) smooth(l, A, false);
 }

@@ -22,6 +22,14 @@
 
 namespace kf {
 
+// Rows of (index, weight) pairs in one array: row r is [start[r], start[r + 1]).
+struct WeightedRows {
+  std::vector<int> start{0}, index;
+  std::vector<double> w;
+  // From per-row lists, in their order.
+  static WeightedRows from(const std::vector<std::vector<std::pair<int, double>>>& rows);
+};
+
 class GridMultigrid {
  public:
   // Builds the hierarchy for the grid and the pattern of A (fixed for the sheet). `free`: 0 on pinned
@@ -41,15 +49,12 @@ class GridMultigrid {
     std::vector<Mat3> inv_diag;       // damped block-Jacobi smoother: omega A_ii^-1 (0 on pinned rows)
     std::vector<char> active;         // rows the smoother and residual touch
     // Interpolation to this level's nodes from the next coarser level: node i takes
-    // sum w coarse[k] over [interp_start[i], interp_start[i + 1]).
-    std::vector<int> interp_start, interp_node;
-    std::vector<double> interp_w;
-    // Restriction: coarse node c gathers sum w fine[k] over [restrict_start[c], restrict_start[c + 1]).
-    std::vector<int> restrict_start, restrict_node;
-    std::vector<double> restrict_w;
-    // Galerkin product into the next level: coarse slot s sums w * block(fine slot) over its range.
-    std::vector<int> galerkin_start, galerkin_slot;
-    std::vector<double> galerkin_w;
+    // sum w coarse[index] over interp's range i.
+    WeightedRows interp;
+    // Restriction: coarse node c gathers sum w fine[index] over restriction's range c.
+    WeightedRows restriction;
+    // Galerkin product into the next level: coarse slot s sums w * block(index) over galerkin's range s.
+    WeightedRows galerkin;
     VecX r, e, t;                     // residual, correction, scratch
   };
   const BlockSparse3& op(int l, const BlockSparse3& fine) const { return l == 0 ? fine : levels_[l].A_own; }
