@@ -136,6 +136,7 @@ ClothSpec parse_cloth_spec(Block& b) {
   s.cg_max_iterations = b.integer("cg_max_iterations", s.cg_max_iterations, 1, 1'000'000);
   s.cg_preconditioner = b.string("cg_preconditioner", s.cg_preconditioner, {"auto", "incomplete_cholesky", "multigrid", "block_jacobi"});
   s.solver = b.string("solver", s.solver, {"pcg", "direct"});
+  s.control_integration = b.string("control_integration", s.control_integration, {"implicit", "explicit"});
   s.max_halvings = b.integer("max_halvings", s.max_halvings, 0, 16);
   s.contact_ramp = b.number("contact_ramp", s.contact_ramp, 0.0, 1.0);
   for (Block& c : b.array("colliders")) s.colliders.push_back(parse_collider(std::move(c)));

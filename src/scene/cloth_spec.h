@@ -79,6 +79,11 @@ struct ClothSpec {
   // "block_jacobi".
   std::string cg_preconditioner = "auto";
   std::string solver = "pcg";           // "direct": sparse LDL^T per step, exact to round-off
+  // "implicit": control forces enter the backward-Euler solve with the springs, which filters them (a
+  // force against a stiff spring barely moves it within a step). "explicit": each substep adds h u / m to
+  // the velocities after the solve, so a control reaches every mode of the sheet alike; an end-state
+  // keyframe's stiff (stretch) modes then stop slowing the optimiser by the springs' stiffness squared.
+  std::string control_integration = "implicit";
   // A step that gains energy is split in halves, at most this many times (0: never split).
   int max_halvings = 8;
   // Every contact's stiffness rises from 0 to full over this fraction of its thickness (ContactProfile);
@@ -88,6 +93,7 @@ struct ClothSpec {
 
   int particles() const { return nx * ny; }
   bool direct_solver() const { return solver == "direct"; }
+  bool explicit_controls() const { return control_integration == "explicit"; }
   bool block_jacobi() const { return cg_preconditioner == "block_jacobi"; }
   int index(int i, int j) const { return j * nx + i; }
 };

@@ -50,6 +50,17 @@ const Case kCases[] = {
      R"({"kind": "per_frame", "alpha": 1e-5})",
      R"([{"type": "arch", "frame": 3, "weight": 100, "axis_point": [0, -0.2, 0], "axis": [0, 0, 1], "radius": 0.3}])",
      1e-4},
+    // Control forces added after the solve (cloth.control_integration): their adjoint skips the solve.
+    {"explicit_compressed_arch", R"("origin": [-0.25, 0, -0.25], "v_axis": [0, 0, 1], "gravity": [0, 0, 0],
+       "control_integration": "explicit")",
+     R"({"kind": "per_frame", "alpha": 1e-5})",
+     R"([{"type": "arch", "frame": 3, "weight": 100, "axis_point": [0, -0.2, 0], "axis": [0, 0, 1], "radius": 0.3}])",
+     1e-4},
+    {"explicit_sphere_pinned", R"("origin": [-0.25, 0.12, -0.25], "v_axis": [0, 0, 1], "pins": "top_corners",
+       "control_integration": "explicit",
+       "colliders": [{"type": "sphere", "center": [0, 0, 0], "radius": 0.1, "thickness": 0.03, "stiffness": 3000}])",
+     R"({"kind": "per_step", "alpha": 1e-4})",
+     R"([{"type": "center_of_mass", "frame": 3, "weight": 100, "target": [0.05, 0.2, 0]}])", 1e-4},
 };
 
 Scene scene_of(const Case& c, int substeps) {

@@ -209,10 +209,13 @@ void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs) {
 bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u,
                               VecX& x_next, VecX& v_next) {
   const double h = std::ldexp(h_, -depth), t1 = t0 + std::ldexp(1.0, -depth);
+  const bool explicit_u = spec_.explicit_controls();
   assemble(n, x, v, h);
   tbb::parallel_for(tbb::blocked_range<int>(0, p_, kParticleGrain), [&](const tbb::blocked_range<int>& r) {
-    for (int i = r.begin(); i < r.end(); ++i)
-      seg(rhs_, i) = h * (seg(force_, i) + h * stiffness_times_velocity(i, v) + seg(u, i));
+    for (int i = r.begin(); i < r.end(); ++i) {
+      const Vec3 ui = explicit_u ? Vec3::Zero() : Vec3(seg(u, i));
+      seg(rhs_, i) = h * (seg(force_, i) + h * stiffness_times_velocity(i, v) + ui);
+    }
   });
   // Pinned particles go exactly to their track position at n + t1 (linear within the step).
   for (int i : pinned_list_) {
@@ -230,7 +233,10 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
   last_cg_ = res.iterations;
   v_next.resize(3 * p_);
   x_next.resize(3 * p_);
-  v_next = v + dv_;
+  v_next = v + dv_;  // dv_ stays the solve's part: the record's dv, which the adjoint's A(x) dv terms need
+  if (explicit_u)
+    for (int i = 0; i < p_; ++i)
+      if (free_[i]) seg(v_next, i) += (h / mass_[i]) * seg(u, i);
   x_next = x + h * v_next;
   return res.converged && x_next.allFinite() && v_next.allFinite();
 }
@@ -301,10 +307,10 @@ PcgResult ClothSystem::solve(const VecX& b, VecX& x, bool warm) {
   return r;
 }
 
-double ClothSystem::external_work(const VecX& u, const VecX& x0, const VecX& x1) const {
+double ClothSystem::external_work(const VecX& u, const VecX& x0, const VecX& x1, bool control) const {
   double w = 0;
   for (int i = 0; i < p_; ++i)
-    if (free_[i]) w += seg(u, i).dot(seg(x1, i) - seg(x0, i));
+    if (control && free_[i]) w += seg(u, i).dot(seg(x1, i) - seg(x0, i));
   for (const BucklingSpring& s : springs_) {
     if (free_[s.a] && free_[s.b]) continue;
     // A pin does work -f . dx against the elastic force f on its particle (trapezoidal rule).
@@ -322,13 +328,22 @@ bool ClothSystem::checked_step(int n, int depth, double t0, const VecX& x, const
   if (depth < spec_.max_halvings) {
     // Backward Euler with damping never gains energy; the linearised step does when it moves particles
     // fast across springs or into colliders, and halving the step shrinks what it invents ~4-16 times.
-    const Energy before = energy_at_start(n, x, v), after = solved ? energy(n, x_next, v_next) : Energy{};
-    const double work = solved ? external_work(u, x, x_next) : 0.0;
+    // An explicit control's kick is external to the solve (it may store more spring energy than its
+    // work in one step): the check measures the solve's own end state.
+    const bool kick = spec_.explicit_controls();
+    if (kick && solved) {
+      solved_v_ = v + dv_;
+      solved_x_ = x + std::ldexp(h_, -depth) * solved_v_;
+    }
+    const VecX& xc = kick ? solved_x_ : x_next;
+    const VecX& vc = kick ? solved_v_ : v_next;
+    const Energy before = energy_at_start(n, x, v), after = solved ? energy(n, xc, vc) : Energy{};
+    const double work = solved ? external_work(u, x, xc, !kick) : 0.0;
     // The energy the step moves is the tolerance's scale (a NaN gain fails the test and splits).
     const double moved = before.kinetic + before.elastic + before.contact + std::abs(work) +
                          std::abs(after.gravity - before.gravity);
     accept = solved && after.total() - before.total() - work <= 1e-3 * moved + 1e-12;
-    if (accept) remember_energy(x_next, v_next, after);
+    if (accept && !kick) remember_energy(x_next, v_next, after);
   }
   if (accept) {
     if (int(rec.substeps.size()) <= rec.count) rec.substeps.emplace_back();
@@ -398,7 +413,7 @@ void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v,
   last_adjoint_n_ = res.converged ? n : -2;
   last_adjoint_cg_ = res.iterations;
   const VecX& w = w_;
-  c_ = v + dv;  // v1
+  c_ = v + dv;  // v1 (without an explicit control's h u / m: what K multiplies in the step's equation)
   xhat.resize(3 * p_);
   vhat.resize(3 * p_);
   // Per spring, with dw = w_b - w_a and G = d f_a / d x_b (elastic + damping, exact): (Kx^T w)_a = G^T dw,
@@ -446,7 +461,13 @@ void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v,
     col->add_cross_transpose(n, w, h, xhat);
     if (exact) col->add_definite_stiffness_derivative(n, x, w, c_, h * h, xhat);
   }
-  uhat += h * w;
+  if (!spec_.explicit_controls()) {
+    uhat += h * w;
+    return;
+  }
+  // v1 = v + dv + h u / m on free particles: u's adjoint skips the solve (rhs = vhat1 + h xhat1).
+  for (int i = 0; i < p_; ++i)
+    if (free_[i]) seg(uhat, i) += (h / mass_[i]) * seg(rhs_, i);
 }
 
 BlockSparse3 ClothSystem::block_matrix(const std::vector<Mat3>& per_spring, const std::vector<Mat3>& diagonal) const {

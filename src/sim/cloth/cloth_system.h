@@ -132,7 +132,8 @@ class ClothSystem final : public System {
   // undamped (bending) springs.
   BlockSparse3 block_matrix(const std::vector<Mat3>& per_spring, const std::vector<Mat3>& diagonal) const;
   // Work (J) of the control u on the free particles and of the pins on their springs from x0 to x1.
-  double external_work(const VecX& u, const VecX& x0, const VecX& x1) const;
+  // `control`: whether u's work counts (an explicit control's kick is outside the checked solve).
+  double external_work(const VecX& u, const VecX& x0, const VecX& x1, bool control) const;
 
   struct Incident {
     int spring;  // index into springs_
@@ -171,6 +172,7 @@ class ClothSystem final : public System {
   VecX adj_x_, adj_v_, adj_u_;           // adjoint of one substep (walking split steps back)
   int last_substeps_ = 0;
   VecX energy_x_, energy_v_;  // the state whose collider-free energy is cached_energy_
+  VecX solved_x_, solved_v_;  // with explicit controls: a substep's end without the kick, which the check measures
   Energy cached_energy_;
   VecX c_;   // v + dv of the step being walked back
   AdjointKind adjoint_ = AdjointKind::kExact;
