@@ -91,10 +91,10 @@ TEST(CapeFigure, BlendEndsFarCloserToClipBThanTheUncontrolledCape) {
 
 // scenes/cape-a.json (a stunt double dropped from a 1.5 m ledge) and scenes/cape-b.json (a calm take) as
 // they are, then tests/figures/cape-blend-small.json -- scenes/cape-blend.json with 80 evaluations instead
-// of 900, both written by scripts/make_cape_scenes.py -- through `keyframe optimize`'s own job. Measured:
-// 0.96 % RMS position error (uncontrolled 4.93 %), RMS velocity error 0.39 of the uncontrolled one, over 400
-// self and 3,000 body contacts, in 12 s. Without optimisation (max_evaluations 0) the position and velocity
-// checks fail.
+// of 900, both written by scripts/make_cape_scenes.py -- through `keyframe optimize`'s own job; its checks are
+// the figure's own bars. Measured: 0.40 % RMS position error (uncontrolled 4.93 %), RMS velocity error 0.16
+// of the uncontrolled one, 409 self and 3,019 body contacts, in 11 s. Without optimisation (max_evaluations
+// 0) the position and velocity checks fail.
 TEST(CapeFigure, BlendFromTheStuntFallEndsNearTheCalmTakesPositionsAndVelocities) {
   test::TempDir dir;
   const std::filesystem::path source(KEYFRAME_SOURCE_DIR);
@@ -125,9 +125,8 @@ TEST(CapeFigure, BlendFromTheStuntFallEndsNearTheCalmTakesPositionsAndVelocities
   const double v_before = end.at("uncontrolled").at("rms_velocity_error");
   const double v_after = end.at("controlled").at("rms_velocity_error");
   EXPECT_GT(before, 3.0) << "the blend starts too close to clip B's end for the check to mean anything";
-  EXPECT_LT(after, 1.5);
-  EXPECT_LT(after, 0.3 * before);
-  EXPECT_LT(v_after, 0.45 * v_before);
+  EXPECT_LE(after, 0.5);  // % of the cape's length
+  EXPECT_LE(v_after, 0.25 * v_before);
   EXPECT_GE(stats.at("self_contacts").get<double>(), 100.0);
   EXPECT_GE(stats.at("body_contacts").get<double>(), 1000.0);
 }
