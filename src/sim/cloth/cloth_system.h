@@ -167,7 +167,9 @@ class ClothSystem final : public System {
   FilteredDirect direct_;  // cloth.solver = "direct"
   bool direct_solve_ = false, direct_ok_ = false;
   int last_cg_ = 0, last_adjoint_cg_ = 0;
-  VecX w_;   // last adjoint solution (warm start)
+  VecX w_;         // last adjoint solution (warm start)
+  VecX w_before_;  // the one before it, of step w_before_n_ (-2: none), for the extrapolated warm start
+  int w_before_n_ = -2;
   std::vector<VecX> split_x_, split_v_;  // per depth: the state between two halves of a split step
   VecX adj_x_, adj_v_, adj_u_;           // adjoint of one substep (walking split steps back)
   int last_substeps_ = 0;
