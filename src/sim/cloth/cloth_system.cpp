@@ -131,6 +131,8 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   aw_.setZero(3 * p_);
   w_.setZero(3 * p_);
   w_before_.setZero(3 * p_);
+  solved_x_.setZero(3 * p_);
+  solved_v_.setZero(3 * p_);
   c_.setZero(3 * p_);
   direct_solve_ = spec.direct_solver();
   split_x_.resize(spec.max_halvings);
@@ -210,11 +212,11 @@ void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs) {
 bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u,
                               VecX& x_next, VecX& v_next) {
   const double h = std::ldexp(h_, -depth), t1 = t0 + std::ldexp(1.0, -depth);
-  const bool explicit_u = spec_.explicit_controls();
+  const bool kick = spec_.explicit_controls();  // u added after the solve, not in b
   assemble(n, x, v, h);
   tbb::parallel_for(tbb::blocked_range<int>(0, p_, kParticleGrain), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i) {
-      const Vec3 ui = explicit_u ? Vec3::Zero() : Vec3(seg(u, i));
+      const Vec3 ui = kick ? Vec3::Zero() : Vec3(seg(u, i));
       seg(rhs_, i) = h * (seg(force_, i) + h * stiffness_times_velocity(i, v) + ui);
     }
   });
@@ -235,7 +237,7 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
   v_next.resize(3 * p_);
   x_next.resize(3 * p_);
   v_next = v + dv_;  // dv_ stays the solve's part: the record's dv, which the adjoint's A(x) dv terms need
-  if (explicit_u)
+  if (kick)
     for (int i = 0; i < p_; ++i)
       if (free_[i]) seg(v_next, i) += (h / mass_[i]) * seg(u, i);
   x_next = x + h * v_next;

@@ -7,7 +7,9 @@
 //           stiffness, D the spring damping and air drag (the non-symmetric position derivative of spring
 //           damping is left out, so A is symmetric and the backward solve reuses the forward PCG).
 //           A pinned particle moves to its PinTrack position at n+1 whatever its state.
-// Both adjoints solve A w = vhat1 + h xhat1 on the free set (w = 0 on pins), then uhat = h w,
+//           With cloth.control_integration "explicit", u leaves b and v1 = v + dv + h u / m instead.
+// Both adjoints solve A w = vhat1 + h xhat1 on the free set (w = 0 on pins), then uhat = h w (explicit
+// controls: uhat = h (vhat1 + h xhat1) / m, no solve),
 // vhat = M w (0 on pins) and xhat = xhat1 + h Kx^T w + ..., Kx the exact df/dx (springs, spring damping,
 // collider curvature, self-contact cross blocks: any bias there is O(h) per step).
 //   exact: the transpose of the Jacobian of the step as implemented. It adds the position derivative of
@@ -25,7 +27,8 @@
 // them back, and never decide again, so the exact adjoint stays the Jacobian of the step taken.
 // A is recomputed at each substep's start in the backward pass rather than stored.
 // PCG starts from the previous step's solution when steps come in sequence (n after n-1 forward, n after
-// n+1 backward) and from zero otherwise, so a rollout is the same function of its inputs on every run.
+// n+1 backward; backward, from the extrapolation of the last two when both are in sequence) and from zero
+// otherwise, so a rollout is the same function of its inputs on every run.
 #include <memory>
 #include <vector>
 
