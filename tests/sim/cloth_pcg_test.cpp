@@ -40,13 +40,7 @@ class ClothPcg : public ::testing::Test {
     // Rebuild the block matrix from the system's own (same pattern, same values).
     free.assign(sys.particles(), 1);
     for (int i = 0; i < sys.particles(); ++i) free[i] = !sys.pinned(i);
-    std::vector<std::vector<int>> cols(sys.particles());
-    for (int k = 0; k < A.outerSize(); ++k)
-      for (SpMat::InnerIterator it(A, k); it; ++it) cols[it.row() / 3].push_back(int(it.col() / 3));
-    B.set_pattern(cols);
-    for (int k = 0; k < A.outerSize(); ++k)
-      for (SpMat::InnerIterator it(A, k); it; ++it)
-        B.block(B.find(int(it.row() / 3), int(it.col() / 3)))(it.row() % 3, it.col() % 3) = it.value();
+    B = BlockSparse3::from_sparse(A);
     b = VecX::Random(A.rows());
   }
 

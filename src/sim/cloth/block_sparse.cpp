@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 
 #include "core/check.h"
 
@@ -42,7 +43,7 @@ void BlockSparse3::multiply(const VecX& x, VecX& y) const {
   }
   tbb::parallel_for(tbb::blocked_range<int>(0, block_rows(), kGrain), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i) seg(y, i) = row_times(i, x);
-  });
+  }, tbb::static_partitioner());
 }
 
 SpMat BlockSparse3::to_sparse() const {
@@ -54,6 +55,18 @@ SpMat BlockSparse3::to_sparse() const {
   SpMat m(3 * block_rows(), 3 * block_rows());
   m.setFromTriplets(t.begin(), t.end());
   return m;
+}
+
+BlockSparse3 BlockSparse3::from_sparse(const SpMat& m) {
+  std::vector<std::vector<int>> cols(m.rows() / 3);
+  for (int k = 0; k < m.outerSize(); ++k)
+    for (SpMat::InnerIterator it(m, k); it; ++it) cols[it.row() / 3].push_back(int(it.col() / 3));
+  BlockSparse3 b;
+  b.set_pattern(cols);
+  for (int k = 0; k < m.outerSize(); ++k)
+    for (SpMat::InnerIterator it(m, k); it; ++it)
+      b.block(b.find(int(it.row() / 3), int(it.col() / 3)))(it.row() % 3, it.col() % 3) = it.value();
+  return b;
 }
 
 }  // namespace kf

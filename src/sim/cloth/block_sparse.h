@@ -45,6 +45,9 @@ class BlockSparse3 {
   void multiply(const VecX& x, VecX& y) const;
   // The matrix as an Eigen sparse matrix (tests, diagnostics; allocates).
   SpMat to_sparse() const;
+  // The blocks of an Eigen sparse matrix of 3 x 3 blocks, the pattern the blocks holding its entries
+  // (tests; allocates).
+  static BlockSparse3 from_sparse(const SpMat& m);
 
  private:
   std::vector<int> row_start_{0}, col_, diag_;

@@ -2,23 +2,58 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 
 namespace kf {
+
+namespace {
+// Vector operations run over fixed chunks of particles, in parallel when there are several, and sums add
+// each chunk's partial sum in chunk order: the same bits on any thread count. Below kParallelFrom
+// particles the whole vector is one chunk (a parallel loop costs more than it saves there), so small sheets
+// keep the rounding of whole-vector sums.
+constexpr int kChunk = 256;
+constexpr int kParallelFrom = 1024;
+
+int chunk_size(int n) { return n < kParallelFrom ? std::max(n, 1) : kChunk; }
+
+// f(begin, end, chunk) over [0, n).
+template <class F>
+void for_chunks(int n, F&& f) {
+  const int size = chunk_size(n), chunks = (n + size - 1) / size;
+  if (chunks <= 1) {
+    f(0, n, 0);
+    return;
+  }
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, chunks, 1),
+      [&](const tbb::blocked_range<int>& r) {
+        for (int c = r.begin(); c < r.end(); ++c) f(c * size, std::min(n, (c + 1) * size), c);
+      },
+      tbb::static_partitioner());
+}
+
+// The entries of particles [begin, end).
+auto span(VecX& v, int begin, int end) { return v.segment(3 * begin, 3 * (end - begin)); }
+auto span(const VecX& v, int begin, int end) { return v.segment(3 * begin, 3 * (end - begin)); }
+}  // namespace
 
 void FilteredPcg::resize(int p, Preconditioner kind, int nx, int ny) {
   kind_ = kind;
   nx_ = nx;
   ny_ = ny;
   mg_ready_ = false;
+  ic_ = IncompleteCholesky();  // analysed again at the first prepare
   if (kind == Preconditioner::kMultigrid && nx * ny != p) kind_ = Preconditioner::kIncompleteCholesky;
   inv_diag_.assign(p, Mat3::Identity());
   r_.setZero(3 * p);
   z_.setZero(3 * p);
   p_.setZero(3 * p);
   q_.setZero(3 * p);
+  partial_.assign((p + chunk_size(p) - 1) / chunk_size(p), 0.0);
 }
 
 void FilteredPcg::prepare(const BlockSparse3& A, const std::vector<char>& free) {
@@ -32,8 +67,8 @@ void FilteredPcg::prepare(const BlockSparse3& A, const std::vector<char>& free) 
     if (mg_ok_) return;
   }
   if (kind_ == Preconditioner::kIncompleteCholesky) {
-    if (int(lower_.size()) != A.nonzero_blocks()) lower_.assign(A.nonzero_blocks(), Mat3::Zero());
-    ic_ok_ = factor_ic(A, free);
+    if (!ic_.analysed_for(A)) ic_.analyse(A);  // the pattern is the sheet's: its order is made once
+    ic_ok_ = ic_.factor(A, free);
     if (ic_ok_) return;
   }
   prepare_block_jacobi(A, free);
@@ -46,47 +81,17 @@ void FilteredPcg::prepare_block_jacobi(const BlockSparse3& A, const std::vector<
   });
 }
 
-// Left-looking IC(0) by block rows: L_ij = (A_ij - sum_{m<j} L_im L_jm^T) L_jj^-T on A's pattern, then
-// L_ii = chol(A_ii - sum_{m<i} L_im L_im^T). Pinned rows and columns are left out (the filtered system).
-bool FilteredPcg::factor_ic(const BlockSparse3& A, const std::vector<char>& free) {
-  const int n = A.block_rows();
-  for (int i = 0; i < n; ++i) {
-    if (!free[i]) {
-      inv_diag_[i].setZero();
-      continue;
-    }
-    const int d = A.diag_slot(i);
-    Mat3 diag = A.block(d);
-    for (int k = A.row_start(i); k < d; ++k) {
-      const int j = A.col(k);
-      if (!free[j]) {
-        lower_[k].setZero();
-        continue;
-      }
-      Mat3 s = A.block(k);
-      // Columns m < j present in both row i and row j (both lists sorted).
-      int a = A.row_start(i), b = A.row_start(j);
-      const int b_end = A.diag_slot(j);
-      while (a < k && b < b_end) {
-        const int ca = A.col(a), cb = A.col(b);
-        if (ca < cb) ++a;
-        else if (cb < ca) ++b;
-        else {
-          if (free[ca]) s.noalias() -= lower_[a] * lower_[b].transpose();
-          ++a;
-          ++b;
-        }
-      }
-      lower_[k].noalias() = s * inv_diag_[j].transpose();
-      diag.noalias() -= lower_[k] * lower_[k].transpose();
-    }
-    Eigen::LLT<Mat3> llt(diag);
-    if (llt.info() != Eigen::Success) return false;
-    const Mat3 l = llt.matrixL();
-    if (!(l.diagonal().minCoeff() > 1e-12 * std::sqrt(A.block(d).diagonal().maxCoeff()))) return false;
-    inv_diag_[i] = l.inverse();
-  }
-  return true;
+double FilteredPcg::sum_partials(int n) const {
+  double sum = 0;
+  const int size = chunk_size(n);
+  for (int c = 0; c < (n + size - 1) / size; ++c) sum += partial_[c];
+  return sum;
+}
+
+double FilteredPcg::chunked_dot(const VecX& a, const VecX& b) {
+  const int n = int(a.size()) / 3;
+  for_chunks(n, [&](int begin, int end, int c) { partial_[c] = span(a, begin, end).dot(span(b, begin, end)); });
+  return sum_partials(n);
 }
 
 void FilteredPcg::filter(const std::vector<char>& free, VecX& y) const {
@@ -102,27 +107,12 @@ void FilteredPcg::precondition(const BlockSparse3& A, const std::vector<char>& f
     return;
   }
   if (!ic_ok_) {
-    for (int i = 0; i < n; ++i) seg(z, i).noalias() = inv_diag_[i] * seg(r, i);
+    for_chunks(n, [&](int begin, int end, int) {
+      for (int i = begin; i < end; ++i) seg(z, i).noalias() = inv_diag_[i] * seg(r, i);
+    });
     return;
   }
-  // z = L^-T L^-1 r: forward substitution by rows, then backward by columns of L^T.
-  for (int i = 0; i < n; ++i) {
-    if (!free[i]) {
-      seg(z, i).setZero();
-      continue;
-    }
-    Vec3 y = seg(r, i);
-    for (int k = A.row_start(i); k < A.diag_slot(i); ++k)
-      if (free[A.col(k)]) y.noalias() -= lower_[k] * seg(z, A.col(k));
-    seg(z, i).noalias() = inv_diag_[i] * y;
-  }
-  for (int i = n - 1; i >= 0; --i) {
-    if (!free[i]) continue;
-    const Vec3 zi = inv_diag_[i].transpose() * seg(z, i);
-    seg(z, i) = zi;
-    for (int k = A.row_start(i); k < A.diag_slot(i); ++k)
-      if (free[A.col(k)]) seg(z, A.col(k)).noalias() -= lower_[k].transpose() * zi;
-  }
+  ic_.apply(free, r, z);
 }
 
 PcgResult FilteredPcg::solve(const BlockSparse3& A, const std::vector<char>& free, const VecX& b, VecX& x,
@@ -160,25 +150,33 @@ PcgResult FilteredPcg::solve_once(const BlockSparse3& A, const std::vector<char>
   }
   precondition(A, free, r_, z_);
   p_ = z_;
-  double rz = r_.dot(z_);
+  double rz = chunked_dot(r_, z_);
+  const int n = int(free.size());
+  double* part = partial_.data();
   for (int it = 1; it <= max_iterations; ++it) {
-    A.multiply(p_, q_);
-    filter(free, q_);
-    const double pq = p_.dot(q_);
+    for_chunks(n, [&](int begin, int end, int c) {  // q = S A p, and p . q
+      for (int i = begin; i < end; ++i) seg(q_, i) = free[i] ? A.row_times(i, p_) : Vec3::Zero();
+      part[c] = span(p_, begin, end).dot(span(q_, begin, end));
+    });
+    const double pq = sum_partials(n);
     if (!(pq > 0) || !std::isfinite(pq)) break;  // not positive definite on the free set
     const double alpha = rz / pq;
-    x.noalias() += alpha * p_;
-    r_.noalias() -= alpha * q_;
-    r_norm = r_.norm();
+    for_chunks(n, [&](int begin, int end, int c) {  // x += alpha p, r -= alpha q, and r . r
+      span(x, begin, end) += alpha * span(p_, begin, end);
+      span(r_, begin, end) -= alpha * span(q_, begin, end);
+      part[c] = span(r_, begin, end).squaredNorm();
+    });
+    r_norm = std::sqrt(sum_partials(n));
     res.iterations = it;
     if (r_norm <= target) {
       res.converged = true;
       break;
     }
     precondition(A, free, r_, z_);
-    const double rz_new = r_.dot(z_);
+    const double rz_new = chunked_dot(r_, z_);
     if (!(rz_new > 0)) break;  // the preconditioner is not positive definite here
-    p_ = z_ + (rz_new / rz) * p_;
+    const double beta = rz_new / rz;
+    for_chunks(n, [&](int begin, int end, int) { span(p_, begin, end) = span(z_, begin, end) + beta * span(p_, begin, end); });
     rz = rz_new;
   }
   res.relative_residual = b_norm > 0 ? r_norm / b_norm : r_norm;

@@ -2,16 +2,17 @@
 // Preconditioned conjugate gradients with the Baraff-Witkin filter: particles marked constrained keep the
 // value the caller put in x, and the solve runs on the free particles only (S A x = S b).
 // Preconditioner: a multigrid V-cycle over the sheet's grid (GridMultigrid), block incomplete Cholesky
-// IC(0) on the free set (the factor keeps A's block pattern), or the inverse of each free particle's 3x3
+// IC(0) on the free set (IncompleteCholesky), or the inverse of each free particle's 3x3
 // diagonal block (block Jacobi). Multigrid and IC(0) fall back to block Jacobi for a step whose matrix
 // they cannot use (a pivot that is not positive definite; for multigrid also a CG that breaks down).
-// Reductions and triangular solves are serial over a fixed order, so results do not depend on the thread
-// count.
+// Vector operations run in parallel over fixed chunks of particles and sums add the chunks' partial sums
+// in order; IC(0)'s order is fixed by the pattern: results do not depend on the thread count.
 #include <vector>
 
 #include "core/types.h"
 #include "sim/cloth/block_sparse.h"
 #include "sim/cloth/grid_multigrid.h"
+#include "sim/cloth/incomplete_cholesky.h"
 
 namespace kf {
 
@@ -46,14 +47,17 @@ class FilteredPcg {
   void prepare_block_jacobi(const BlockSparse3& A, const std::vector<char>& free);
   void filter(const std::vector<char>& free, VecX& y) const;
   void precondition(const BlockSparse3& A, const std::vector<char>& free, const VecX& r, VecX& z);
-  bool factor_ic(const BlockSparse3& A, const std::vector<char>& free);
+  // Sums in fixed chunks of particles (see for_chunks): the same bits on any thread count.
+  double chunked_dot(const VecX& a, const VecX& b);
+  double sum_partials(int n) const;
   Preconditioner kind_ = Preconditioner::kIncompleteCholesky;
   bool ic_ok_ = false, mg_ok_ = false, mg_ready_ = false;
   int nx_ = 0, ny_ = 0;
   GridMultigrid mg_;
-  std::vector<Mat3> inv_diag_;  // block Jacobi: A_ii^-1; IC(0): L_ii^-1 (lower triangular)
-  std::vector<Mat3> lower_;     // IC(0): L_ij in A's slot (i, j), j < i
+  IncompleteCholesky ic_;
+  std::vector<Mat3> inv_diag_;  // block Jacobi: A_ii^-1
   VecX r_, z_, p_, q_;
+  std::vector<double> partial_;  // one partial sum per chunk
 };
 
 }  // namespace kf

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 
 namespace kf {
 
@@ -24,7 +25,7 @@ void for_rows(int n, const F& f) {
   }
   tbb::parallel_for(tbb::blocked_range<int>(0, n, kRowGrain), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i) f(i);
-  });
+  }, tbb::static_partitioner());
 }
 
 // Nodes of the coarser line: every other one and the last.
