@@ -130,6 +130,7 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   force_.setZero(3 * p_);
   rhs_.setZero(3 * p_);
   dv_.setZero(3 * p_);
+  dv_before_.setZero(3 * p_);
   contact_K_.assign(p_, Mat3::Zero());
   diag_K_.assign(p_, Mat3::Zero());
   diag_D_.assign(p_, Mat3::Zero());
@@ -225,6 +226,16 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
       seg(rhs_, i) = h * (seg(force_, i) + h * stiffness_times_velocity(i, v) + ui);
     }
   }, tbb::static_partitioner());
+  // Substeps start cold, so a split step depends on its inputs only. A warm start extrapolates the last two
+  // solutions linearly when both are there (a sheet's velocity changes smoothly from step to step).
+  const bool warm = depth == 0 && n == last_forward_n_ + 1;
+  if (warm && dv_before_n_ == n - 2) {
+    dv_before_.swap(dv_);  // dv_before_ = dv(n - 1), dv_ = dv(n - 2)
+    dv_ = 2 * dv_before_ - dv_;
+  } else if (warm) {
+    dv_before_ = dv_;
+  }
+  dv_before_n_ = warm ? n - 1 : -2;
   // Pinned particles go exactly to their track position at n + t1 (linear within the step).
   for (int i : pinned_list_) {
     Vec3 a, b, vel;
@@ -235,8 +246,6 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
     }
     seg(dv_, i) = (b - seg(x, i)) / h - seg(v, i);
   }
-  // Substeps start cold, so a split step depends on its inputs only.
-  const bool warm = depth == 0 && n == last_forward_n_ + 1;
   const PcgResult res = solve(rhs_, dv_, warm);
   last_cg_ = res.iterations;
   v_next.resize(3 * p_);
@@ -501,16 +510,22 @@ SpMat ClothSystem::stiffness_matrix() const { return block_matrix(spring_K_, dia
 SpMat ClothSystem::damping_matrix() const { return block_matrix(spring_D_, diag_D_).to_sparse(); }
 
 void ClothSystem::save_step_context(int n, VecX& context) const {
-  if (last_forward_n_ == n - 1) context = dv_;
-  else context.resize(0);
+  context.resize(0);
+  if (last_forward_n_ != n - 1) return;
+  const bool two = dv_before_n_ == n - 2;  // [dv(n - 1)] or [dv(n - 1); dv(n - 2)]
+  context.resize((two ? 6 : 3) * p_);
+  context.head(3 * p_) = dv_;
+  if (two) context.tail(3 * p_) = dv_before_;
 }
 
 void ClothSystem::restore_step_context(int n, const VecX& context) {
-  if (context.size() == dv_.size()) {
-    dv_ = context;
-    last_forward_n_ = n - 1;
-  } else {
-    last_forward_n_ = -2;
+  last_forward_n_ = dv_before_n_ = -2;
+  if (context.size() != 3 * p_ && context.size() != 6 * p_) return;
+  dv_ = context.head(3 * p_);
+  last_forward_n_ = n - 1;
+  if (context.size() == 6 * p_) {
+    dv_before_ = context.tail(3 * p_);
+    dv_before_n_ = n - 2;
   }
 }
 

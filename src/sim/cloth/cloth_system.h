@@ -26,9 +26,9 @@
 // (pins move linearly within a step). The accepted substeps are the step's record; both adjoints walk
 // them back, and never decide again, so the exact adjoint stays the Jacobian of the step taken.
 // A is recomputed at each substep's start in the backward pass rather than stored.
-// PCG starts from the previous step's solution when steps come in sequence (n after n-1 forward, n after
-// n+1 backward; backward, from the extrapolation of the last two when both are in sequence) and from zero
-// otherwise, so a rollout is the same function of its inputs on every run.
+// PCG starts from the linear extrapolation of the last two steps' solutions when steps come in sequence
+// (n after n-1 and n-2 forward, n after n+1 and n+2 backward; from the last one alone when only it is in
+// sequence) and from zero otherwise, so a rollout is the same function of its inputs on every run.
 #include <memory>
 #include <vector>
 
@@ -78,7 +78,7 @@ class ClothSystem final : public System {
   void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const StepRecord& record, const VecX& xhat1,
                     const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) override;
   std::string describe() const override;
-  // The PCG warm start of step n (the solution of step n-1 when that was the last forward solve).
+  // The PCG warm start of step n (the solutions of steps n-1 and n-2 when those were the last forward solves).
   void save_step_context(int n, VecX& context) const override;
   void restore_step_context(int n, const VecX& context) override;
 
@@ -166,6 +166,8 @@ class ClothSystem final : public System {
   std::vector<int> slot_spring_;        // per block of A: the spring joining its row and column, -1 on the diagonal
   std::vector<Mat3> diag_K_, diag_D_;   // per particle: K's and D's diagonal blocks
   VecX force_, rhs_, dv_, aw_;
+  VecX dv_before_;       // the forward solution before dv_'s, of step dv_before_n_ (-2: none)
+  int dv_before_n_ = -2;
   FilteredPcg pcg_;
   FilteredDirect direct_;  // cloth.solver = "direct"
   bool direct_solve_ = false, direct_ok_ = false;
