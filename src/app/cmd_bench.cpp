@@ -77,7 +77,7 @@ void add_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
       });
   s->add_option("--threads", o->solver.threads, "thread counts")
       ->capture_default_str()->delimiter(',')->check(CLI::Range(1, 256));
-  s->add_option("--solver-frames", o->solver.frames, "frames of the 50 x 50 sheet (fewer on bigger ones)")
+  s->add_option("--solver-frames", o->solver.frames, "frames of every sheet (10 steps each)")
       ->capture_default_str()->check(CLI::Range(1, 100000));
   s->add_option("--direct-max-n", o->solver.direct_max_n, "largest n the direct solver runs at")
       ->capture_default_str()->check(CLI::Range(0, 1024));
