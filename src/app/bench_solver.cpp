@@ -1,6 +1,7 @@
 // Solver sweep: the cloth step's cost against particles for each linear solver, on 1 and 2 threads,
 // forward and gradient; and the pinned 50 x 50 sheet beside Blender's bake when `blender` is installed.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -45,8 +46,9 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// One uncontrolled forward simulation of the scene (s, fastest of `repeats`); -1 when it diverged.
-double forward_seconds(const Scene& scene, int repeats) {
+// One uncontrolled forward simulation of the scene (s, fastest of `repeats`); -1 when it diverged. `end`:
+// the last state's positions.
+double forward_seconds(const Scene& scene, int repeats, VecX* end = nullptr) {
   double best = 1e300;
   for (int r = 0; r < repeats; ++r) {
     auto sys = make_system(scene);
@@ -57,6 +59,7 @@ double forward_seconds(const Scene& scene, int repeats) {
     const auto t0 = std::chrono::steady_clock::now();
     if (!simulate(*sys, x0, v0, U, roll)) return -1;
     best = std::min(best, seconds_since(t0));
+    if (end) *end = roll.x.back();
   }
   return best;
 }
@@ -131,14 +134,22 @@ nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::
 
   // Side by side: the whole 120-frame x 10-step bake of the 50 x 50 sheet, default threads.
   if (o.blender_n > 0) {
-    CsvTable side({"n", "frames", "steps", "blender_s", "pcg_s", "pcg_1e-5_s", "blender_over_pcg", "blender_over_pcg_1e-5"});
+    // Speed against error: each run's end positions against a run solved to 1e-12 (RMS over particles, mm).
+    CsvTable side({"n", "frames", "steps", "blender_s", "pcg_s", "pcg_1e-5_s", "blender_over_pcg",
+                   "blender_over_pcg_1e-5", "pcg_rms_mm", "pcg_1e-5_rms_mm"});
     const double b = blender_seconds(o.blender_script, o.blender_n, out);
-    const double pcg = forward_seconds(solver_scene(o.blender_n, "pcg", 120), o.repeats);
-    const double loose = forward_seconds(solver_scene(o.blender_n, "pcg-1e-5", 120), o.repeats);
+    VecX reference, tight, loose;
+    forward_seconds(solver_scene(o.blender_n, "pcg-1e-12", 120), 1, &reference);
+    const double pcg = forward_seconds(solver_scene(o.blender_n, "pcg", 120), o.repeats, &tight);
+    const double loose_s = forward_seconds(solver_scene(o.blender_n, "pcg-1e-5", 120), o.repeats, &loose);
+    auto rms_mm = [&](const VecX& x) {
+      return x.size() == reference.size() ? fmt(1e3 * (x - reference).norm() / std::sqrt(double(x.size() / 3)))
+                                          : std::string("nan");
+    };
     if (b < 0) std::cerr << "bench solver: blender or " << o.blender_script << " not found; no side-by-side\n";
     auto ratio = [&](double ours) { return b > 0 && ours > 0 ? fmt(b / ours) : std::string("nan"); };
-    side.add({std::to_string(o.blender_n), "120", "1200", b > 0 ? fmt(b) : "nan", fmt(pcg), fmt(loose), ratio(pcg),
-              ratio(loose)});
+    side.add({std::to_string(o.blender_n), "120", "1200", b > 0 ? fmt(b) : "nan", fmt(pcg), fmt(loose_s), ratio(pcg),
+              ratio(loose_s), rms_mm(tight), rms_mm(loose)});
     side.write(out / "solver_blender.csv");
     summary["blender"] = side.excerpt();
     std::cout << "solver_blender.csv\n" << side.excerpt() << std::endl;

@@ -137,7 +137,8 @@ bool IncompleteCholesky::factor(const BlockSparse3& A, const std::vector<char>& 
   return ok[0] && ok[1] && factor_rows(A, free, end_[1], int(order_.size()));
 }
 
-// L y = r by rows, in elimination order.
+// L y = r by rows, in elimination order. Entries in pinned columns are zero in the factor (and z is zero on
+// pinned rows), so no row asks which of its columns are free.
 void IncompleteCholesky::forward_rows(const std::vector<char>& free, const VecX& r, VecX& z, int begin,
                                       int end) const {
   for (int q = begin; q < end; ++q) {
@@ -147,8 +148,7 @@ void IncompleteCholesky::forward_rows(const std::vector<char>& free, const VecX&
       continue;
     }
     Vec3 y = seg(r, i);
-    for (int k = start_[q]; k < start_[q + 1]; ++k)
-      if (free[col_[k]]) y.noalias() -= lower_[k] * seg(z, col_[k]);
+    for (int k = start_[q]; k < start_[q + 1]; ++k) y.noalias() -= lower_[k] * seg(z, col_[k]);
     seg(z, i).noalias() = inv_diag_[i] * y;
   }
 }
@@ -160,8 +160,7 @@ void IncompleteCholesky::backward_rows(const std::vector<char>& free, VecX& z, i
     if (!free[i]) continue;
     const Vec3 zi = inv_diag_[i].transpose() * seg(z, i);
     seg(z, i) = zi;
-    for (int k = start_[q]; k < start_[q + 1]; ++k)
-      if (free[col_[k]]) seg(z, col_[k]).noalias() -= lower_[k].transpose() * zi;
+    for (int k = start_[q]; k < start_[q + 1]; ++k) seg(z, col_[k]).noalias() -= lower_[k].transpose() * zi;
   }
 }
 
