@@ -21,10 +21,12 @@ struct SolverSweepOptions {
   // IC(0) PCG at 1e-8 / 1e-5, multigrid PCG at 1e-8, the scene default, sparse Cholesky
   std::vector<std::string> solvers{"pcg", "pcg-1e-5", "mg", "auto", "direct"};
   std::vector<int> threads{1, 2};
-  int frames = 4;      // frames of the 50 x 50 sheet (10 steps each); bigger sheets run proportionally fewer
+  int frames = 4;      // frames of every sheet (10 steps each)
   int repeats = 2;     // timings are the fastest of this many runs
   int direct_max_n = 64;  // the direct solver only up to this n
   int blender_n = 50;  // side-by-side sheet (0: none)
+  // IC(0) PCG tolerances of the side-by-side (speed against error; the first is the scene default)
+  std::vector<double> blender_tolerances{1e-8, 1e-6, 1e-5, 1e-4, 1e-3};
   std::filesystem::path blender_script = "../shared/anchors/blender/bench.py";
 };
 

@@ -83,6 +83,9 @@ void add_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
       ->capture_default_str()->check(CLI::Range(0, 1024));
   s->add_option("--blender-n", o->solver.blender_n, "sheet of the Blender side-by-side (0: none)")
       ->capture_default_str()->check(CLI::Range(0, 1024));
+  s->add_option("--blender-tolerances", o->solver.blender_tolerances,
+                "IC(0) PCG tolerances of our runs beside Blender's (each run's end state against a 1e-12 solve)")
+      ->capture_default_str()->check(CLI::Range(1e-15, 1.0));
   s->add_option("--blender-script", o->solver.blender_script, "the anchor's Blender script")->capture_default_str();
   auto* a = sub->add_option_group("adjoint sweep");
   a->add_option("--adjoint-scenes", o->adjoint.scenes, "cloth scenes (names in --scene-dir) compared exact vs swap")

@@ -132,13 +132,13 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   force_.setZero(3 * p_);
   rhs_.setZero(3 * p_);
   dv_.setZero(3 * p_);
-  dv_before_.setZero(3 * p_);
+  forward_start_.resize(3 * p_);
   contact_K_.assign(p_, Mat3::Zero());
   diag_K_.assign(p_, Mat3::Zero());
   diag_D_.assign(p_, Mat3::Zero());
   aw_.setZero(3 * p_);
   w_.setZero(3 * p_);
-  w_before_.setZero(3 * p_);
+  adjoint_start_.resize(3 * p_);
   solved_x_.setZero(3 * p_);
   solved_v_.setZero(3 * p_);
   c_.setZero(3 * p_);
@@ -228,16 +228,8 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
       seg(rhs_, i) = h * (seg(force_, i) + h * stiffness_times_velocity(i, v) + ui);
     }
   }, tbb::static_partitioner());
-  // Substeps start cold, so a split step depends on its inputs only. A warm start extrapolates the last two
-  // solutions linearly when both are there (a sheet's velocity changes smoothly from step to step).
-  const bool warm = depth == 0 && n == last_forward_n_ + 1;
-  if (warm && dv_before_n_ == n - 2) {
-    dv_before_.swap(dv_);  // dv_before_ = dv(n - 1), dv_ = dv(n - 2)
-    dv_ = 2 * dv_before_ - dv_;
-  } else if (warm) {
-    dv_before_ = dv_;
-  }
-  dv_before_n_ = warm ? n - 1 : -2;
+  // Substeps start cold, so a split step depends on its inputs only.
+  const bool warm = depth == 0 && forward_start_.guess(n, dv_);
   // Pinned particles go exactly to their track position at n + t1 (linear within the step).
   for (int i : pinned_list_) {
     Vec3 a, b, vel;
@@ -250,6 +242,7 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
   }
   const PcgResult res = solve(rhs_, dv_, warm);
   last_cg_ = res.iterations;
+  if (depth == 0) forward_start_.remember(n, dv_);
   v_next.resize(3 * p_);
   x_next.resize(3 * p_);
   v_next = v + dv_;  // dv_ stays the solve's part: the record's dv, which the adjoint's A(x) dv terms need
@@ -392,7 +385,7 @@ bool ClothSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
   const bool ok = checked_step(n, 0, 0.0, x, v, u, x_next, v_next, rec);
   last_substeps_ = rec.count;
   // The next step starts warm only from an unsplit step's solution.
-  last_forward_n_ = ok && rec.count == 1 ? n : -2;
+  if (!ok || rec.count != 1) forward_start_.forget();
   return ok;
 }
 
@@ -418,7 +411,7 @@ void ClothSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX&,
   }
   xhat.swap(adj_x_);
   vhat.swap(adj_v_);
-  last_adjoint_n_ = -2;
+  adjoint_start_.forget();
 }
 
 void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v, const VecX& dv, bool warm_ok,
@@ -426,19 +419,11 @@ void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v,
   const bool exact = adjoint_ == AdjointKind::kExact;
   assemble(n, x, v, h);
   rhs_ = vhat1 + h * xhat1;
-  // w is zero on pinned particles. A warm solve starts from the linear extrapolation of the last two
-  // solutions when there are two (the adjoint changes smoothly from step to step: 11 % fewer PCG
-  // iterations than starting from the last one over the anchor sheet's 1,200 steps).
-  const bool warm = warm_ok && n == last_adjoint_n_ - 1;
-  if (warm && w_before_n_ == n + 2) {
-    w_before_.swap(w_);  // w_before_ = w(n + 1), w_ = w(n + 2)
-    w_ = 2 * w_before_ - w_;
-  } else if (warm) {
-    w_before_ = w_;
-  }
+  // w is zero on pinned particles (and so is every guess).
+  const bool warm = warm_ok && adjoint_start_.guess(n, w_);
   const PcgResult res = solve(rhs_, w_, warm);
-  w_before_n_ = warm ? n + 1 : -2;
-  last_adjoint_n_ = res.converged ? n : -2;
+  if (warm_ok && res.converged) adjoint_start_.remember(n, w_);
+  else adjoint_start_.forget();
   last_adjoint_cg_ = res.iterations;
   const VecX& w = w_;
   c_ = v + dv;  // v1 (without an explicit control's h u / m: what K multiplies in the step's equation)
@@ -511,25 +496,9 @@ BlockSparse3 ClothSystem::block_matrix(const std::vector<Mat3>& per_spring, cons
 SpMat ClothSystem::stiffness_matrix() const { return block_matrix(spring_K_, diag_K_).to_sparse(); }
 SpMat ClothSystem::damping_matrix() const { return block_matrix(spring_D_, diag_D_).to_sparse(); }
 
-void ClothSystem::save_step_context(int n, VecX& context) const {
-  context.resize(0);
-  if (last_forward_n_ != n - 1) return;
-  const bool two = dv_before_n_ == n - 2;  // [dv(n - 1)] or [dv(n - 1); dv(n - 2)]
-  context.resize((two ? 6 : 3) * p_);
-  context.head(3 * p_) = dv_;
-  if (two) context.tail(3 * p_) = dv_before_;
-}
+void ClothSystem::save_step_context(int n, VecX& context) const { forward_start_.save(n, context); }
 
-void ClothSystem::restore_step_context(int n, const VecX& context) {
-  last_forward_n_ = dv_before_n_ = -2;
-  if (context.size() != 3 * p_ && context.size() != 6 * p_) return;
-  dv_ = context.head(3 * p_);
-  last_forward_n_ = n - 1;
-  if (context.size() == 6 * p_) {
-    dv_before_ = context.tail(3 * p_);
-    dv_before_n_ = n - 2;
-  }
-}
+void ClothSystem::restore_step_context(int n, const VecX& context) { forward_start_.restore(n, context); }
 
 std::string ClothSystem::describe() const {
   std::ostringstream os;

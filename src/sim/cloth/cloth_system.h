@@ -26,9 +26,9 @@
 // (pins move linearly within a step). The accepted substeps are the step's record; both adjoints walk
 // them back, and never decide again, so the exact adjoint stays the Jacobian of the step taken.
 // A is recomputed at each substep's start in the backward pass rather than stored.
-// PCG starts from the linear extrapolation of the last two steps' solutions when steps come in sequence
-// (n after n-1 and n-2 forward, n after n+1 and n+2 backward; from the last one alone when only it is in
-// sequence) and from zero otherwise, so a rollout is the same function of its inputs on every run.
+// PCG starts from the extrapolation of the last steps' solutions when steps come in sequence (WarmStart: n
+// after n-1, n-2, n-3 forward, n after n+1, n+2, n+3 backward) and from zero otherwise, so a rollout is the
+// same function of its inputs on every run.
 #include <memory>
 #include <vector>
 
@@ -39,6 +39,7 @@
 #include "sim/cloth/direct_solve.h"
 #include "sim/cloth/filtered_pcg.h"
 #include "sim/cloth/pin_track.h"
+#include "sim/cloth/warm_start.h"
 #include "sim/system.h"
 
 namespace kf {
@@ -78,7 +79,7 @@ class ClothSystem final : public System {
   void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const StepRecord& record, const VecX& xhat1,
                     const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) override;
   std::string describe() const override;
-  // The PCG warm start of step n (the solutions of steps n-1 and n-2 when those were the last forward solves).
+  // The PCG warm start of step n (the last forward solutions when they were those of steps n-1, n-2, n-3).
   void save_step_context(int n, VecX& context) const override;
   void restore_step_context(int n, const VecX& context) override;
 
@@ -166,15 +167,13 @@ class ClothSystem final : public System {
   std::vector<int> slot_spring_;        // per block of A: the spring joining its row and column, -1 on the diagonal
   std::vector<Mat3> diag_K_, diag_D_;   // per particle: K's and D's diagonal blocks
   VecX force_, rhs_, dv_, aw_;
-  VecX dv_before_;       // the forward solution before dv_'s, of step dv_before_n_ (-2: none)
-  int dv_before_n_ = -2;
+  WarmStart forward_start_{+1};  // the guess of each step's velocity change
   FilteredPcg pcg_;
   FilteredDirect direct_;  // cloth.solver = "direct"
   bool direct_solve_ = false, direct_ok_ = false;
   int last_cg_ = 0, last_adjoint_cg_ = 0;
-  VecX w_;         // last adjoint solution (warm start)
-  VecX w_before_;  // the one before it, of step w_before_n_ (-2: none), for the extrapolated warm start
-  int w_before_n_ = -2;
+  VecX w_;                       // the adjoint solve's solution
+  WarmStart adjoint_start_{-1};  // its guess
   std::vector<VecX> split_x_, split_v_;  // per depth: the state between two halves of a split step
   VecX adj_x_, adj_v_, adj_u_;           // adjoint of one substep (walking split steps back)
   int last_substeps_ = 0;
@@ -183,7 +182,6 @@ class ClothSystem final : public System {
   Energy cached_energy_;
   VecX c_;   // v + dv of the step being walked back
   AdjointKind adjoint_ = AdjointKind::kExact;
-  int last_forward_n_ = -2, last_adjoint_n_ = -2;  // steps of the last solves, -2: none
 };
 
 }  // namespace kf
