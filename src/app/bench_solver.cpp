@@ -158,6 +158,17 @@ nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::
       side.add({std::to_string(o.blender_n), "120", "1200", fmt(tol), ok ? fmt(ours) : "nan", b > 0 ? fmt(b) : "nan",
                 ok && b > 0 ? fmt(b / ours) : "nan", ok ? fmt(1e3 * rms) : "nan", ok ? fmt(1e3 * worst) : "nan"});
     }
+    // One gradient against one forward over the whole 1,200-step anchor run (the table above measures 40
+    // steps, where the warm starts have less history to work with).
+    CsvTable anchor({"n", "frames", "steps", "threads", "forward_s", "gradient_s", "gradient_over_forward"});
+    for (int t : o.threads) {
+      tbb::global_control threads(tbb::global_control::max_allowed_parallelism, t);
+      const BenchPoint p = measure_point(solver_scene(o.blender_n, "pcg", 120), po);
+      anchor.add({std::to_string(o.blender_n), "120", "1200", std::to_string(t), p.diverged ? "nan" : fmt(p.forward_s),
+                  p.diverged ? "nan" : fmt(p.gradient_s), p.diverged ? "nan" : fmt(p.gradient_s / p.forward_s)});
+    }
+    anchor.write(out / "solver_anchor_gradient.csv");
+    std::cout << "solver_anchor_gradient.csv\n" << anchor.excerpt() << std::endl;
     const auto side_csv = out / "solver_blender.csv";
     side.write(side_csv);
     plot_csv(side_csv, out / "solver_blender.png",
