@@ -110,6 +110,27 @@ TEST(ClothSpring, EnergyIsZeroAtRestAndItsGradientIsMinusTheForce) {
   EXPECT_NEAR(spring_energy(z, x), 0.5 * z.k * 0.09, 1e-12);
 }
 
+// The closed-form energy against the tension integrated numerically (composite Simpson, 4,000 intervals):
+// E(e) = -integral of T over compressions 0 .. e, inside the blend, at its end and beyond.
+TEST(ClothSpring, EnergyIsTheIntegralOfTheTensionAcrossTheBlendAndBeyond) {
+  const BucklingSpring s = test_spring();
+  const double e0 = kBuckleBlend * s.f_buckle / (s.k - s.k_post);
+  std::mt19937 rng(11);
+  for (double e : {0.05 * e0, 0.5 * e0, e0, 1.7 * e0, 6.0 * e0}) {
+    const int n = 4000;
+    auto tension = [&](double c) {
+      double T, dT, d2T;
+      spring_tension(s, s.rest - c, T, dT, d2T);
+      return T;
+    };
+    double sum = tension(0) + tension(e);
+    for (int i = 1; i < n; ++i) sum += (i % 2 ? 4 : 2) * tension(e * i / n);
+    const double integral = -sum * e / (3 * n);
+    const double energy = spring_energy(s, pair_at((s.rest - e) / s.rest, s.rest, rng));
+    EXPECT_NEAR(energy, integral, 1e-9 * integral) << "e / e0 = " << e / e0;
+  }
+}
+
 TEST(ClothSpring, JacobianMatchesFiniteDifferencesInTensionAndCompression) {
   const BucklingSpring s = test_spring();
   std::mt19937 rng(7);
