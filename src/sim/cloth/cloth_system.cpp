@@ -27,9 +27,9 @@ constexpr int kParticleGrain = 256;
 
 // "auto": IC(0) below this many particles, where its two-halves order makes it the cheapest CG
 // preconditioner here on one and two threads; multigrid from there on, where IC(0)'s iteration count (which
-// grows with the sheet's side while multigrid's stays flat) catches up with it (measured: 100 x 100 11.5 ms
-// a step with IC(0) against 13.2 with multigrid on two threads, 128 x 128 31.2 against 30.1;
-// tests/results/bench/solver.csv).
+// grows with the sheet's side while multigrid's stays flat) has caught up with it: at 100 x 100 IC(0) is
+// clearly faster, at 128 x 128 the two are within a tenth of each other and multigrid wins on one thread
+// (tests/results/bench/solver.csv).
 constexpr int kMultigridFrom = 15000;
 
 Preconditioner preconditioner_kind(const std::string& name, int particles) {

@@ -1,6 +1,5 @@
 #include "sim/cloth/filtered_pcg.h"
 
-#include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
