@@ -89,6 +89,12 @@ bool simulate(System& sys, const VecX& x0, const VecX& v0, const std::vector<Vec
   return simulate(sys, x0, v0, int(U.size()), [&](int n) -> const VecX& { return U[n]; }, r);
 }
 
+bool simulate_frames(System& sys, const VecX& x0, const VecX& v0, const TimeSpec& t, Rollout& r) {
+  const VecX zero = VecX::Zero(x0.size());
+  return simulate(sys, x0, v0, t.steps(), [&](int) -> const VecX& { return zero; }, r,
+                  {.checkpoint_every = t.substeps});
+}
+
 double cost_value(const StateCost& cost, const Rollout& r) {
   double phi = 0;
   const int dof = int(r.x[0].size());

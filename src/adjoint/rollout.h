@@ -65,6 +65,10 @@ bool simulate(System& sys, const VecX& x0, const VecX& v0, int N, const StepCont
 // The same with all N = U.size() per-step forces given, every state kept.
 bool simulate(System& sys, const VecX& x0, const VecX& v0, const std::vector<VecX>& U, Rollout& r);
 
+// The uncontrolled simulation of t.steps() steps keeping only the frames' states (every t.substeps-th) and no
+// tape: what `keyframe simulate` saves, without the memory of every step's state.
+bool simulate_frames(System& sys, const VecX& x0, const VecX& v0, const TimeSpec& t, Rollout& r);
+
 // Sum of the cost over the rollout's states (every active step must be kept).
 double cost_value(const StateCost& cost, const Rollout& r);
 

@@ -1,5 +1,6 @@
 // Solver sweep: the cloth step's cost against particles for each linear solver, on 1 and 2 threads,
-// forward and gradient; and the pinned 50 x 50 sheet beside Blender's bake when `blender` is installed.
+// forward and gradient; what a motion needs of the solve (end states against the integrator's own error);
+// and the pinned 50 x 50 sheet beside Blender's bake when `blender` is installed.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -54,10 +55,9 @@ double forward_seconds(const Scene& scene, int repeats, VecX* end = nullptr) {
     auto sys = make_system(scene);
     VecX x0, v0;
     sys->initial_state(x0, v0);
-    std::vector<VecX> U(scene.time.steps(), VecX::Zero(sys->dof()));
     Rollout roll;
     const auto t0 = std::chrono::steady_clock::now();
-    if (!simulate(*sys, x0, v0, U, roll)) return -1;
+    if (!simulate_frames(*sys, x0, v0, scene.time, roll)) return -1;
     best = std::min(best, seconds_since(t0));
     if (end) *end = roll.x.back();
   }
@@ -79,6 +79,58 @@ double blender_seconds(const std::filesystem::path& script, int n, const std::fi
     if (!line.empty()) last = line;
   const auto comma = last.rfind(',');
   return comma == std::string::npos ? -1 : std::atof(last.c_str() + comma + 1);
+}
+
+// Where two runs' last positions differ: RMS and largest distance over the particles (mm).
+std::pair<double, double> end_distance_mm(const VecX& a, const VecX& b) {
+  double rms = 0, worst = 0;
+  const int p = int(a.size() / 3);
+  for (int i = 0; i < p; ++i) {
+    const double d = (seg(a, i) - seg(b, i)).norm();
+    rms += d * d;
+    worst = std::max(worst, d);
+  }
+  return {1e3 * std::sqrt(rms / std::max(1, p)), 1e3 * worst};
+}
+
+// What a motion needs of the step's solve: three 30 x 30 sheets over 2 s (hanging from one edge as the
+// anchor does; flung up from two corners; dropped over a sphere onto the ground), each at two step lengths.
+// Each run's end state against the same run solved to 1e-12, beside the integrator's own error there (the
+// 1e-12 run against one at half the step).
+CsvTable motion_tolerance_table(const std::vector<double>& tolerances) {
+  const std::pair<const char*, const char*> sheets[] = {
+      {"hang", R"("pins": "bottom_edge", "origin": [-0.5, 1, -0.5], "u_axis": [1, 0, 0], "v_axis": [0, 0, 1])"},
+      {"fling", R"("pins": "top_corners", "origin": [-0.5, 1, -0.5], "u_axis": [1, 0, 0], "v_axis": [0, 0, 1],
+                   "velocity": [0, 3, 2])"},
+      {"drape", R"("origin": [-0.5, 0.6, 0.5], "v_axis": [0, 0, -1],
+                   "colliders": [{"type": "sphere", "center": [0, 0.3, 0], "radius": 0.25, "stiffness": 2e3},
+                                 {"type": "ground", "stiffness": 2e3}])"}};
+  auto end_state = [](const char* sheet, int substeps, double tol) {
+    std::ostringstream text;
+    text << R"({"time": {"fps": 30, "substeps": )" << substeps << R"(, "frames": 60},
+               "cloth": {"nx": 30, "ny": 30, "cg_tolerance": )" << tol << ", " << sheet << "}}";
+    const Scene scene = parse_scene(text.str(), "bench_motion.json");
+    auto sys = make_system(scene);
+    VecX x0, v0;
+    sys->initial_state(x0, v0);
+    Rollout r;
+    return simulate_frames(*sys, x0, v0, scene.time, r) ? VecX(r.x.back()) : VecX();
+  };
+  CsvTable t({"sheet", "steps_per_s", "tolerance", "rms_mm", "max_mm", "step_error_rms_mm", "step_error_max_mm"});
+  for (const auto& [name, sheet] : sheets)
+    for (int substeps : {2, 8}) {
+      std::cerr << "bench solver: motion tolerance, " << name << ", " << 30 * substeps << " steps/s" << std::endl;
+      const VecX ref = end_state(sheet, substeps, 1e-12), half = end_state(sheet, 2 * substeps, 1e-12);
+      const auto [step_rms, step_max] = end_distance_mm(ref, half);
+      for (double tol : tolerances) {
+        const VecX end = end_state(sheet, substeps, tol);
+        const bool ok = end.size() == ref.size() && half.size() == ref.size();
+        const auto [rms, worst] = ok ? end_distance_mm(end, ref) : std::pair<double, double>{0, 0};
+        t.add({name, std::to_string(30 * substeps), fmt(tol), ok ? fmt(rms) : "nan", ok ? fmt(worst) : "nan",
+               ok ? fmt(step_rms) : "nan", ok ? fmt(step_max) : "nan"});
+      }
+    }
+  return t;
 }
 
 }  // namespace
@@ -132,6 +184,11 @@ nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::
   summary["solver"] = table.excerpt();
   std::cout << "solver.csv\n" << table.excerpt() << std::endl;
 
+  const CsvTable motion = motion_tolerance_table(o.motion_tolerances);
+  motion.write(out / "solver_motion.csv");
+  summary["motion"] = motion.excerpt();
+  std::cout << "solver_motion.csv\n" << motion.excerpt() << std::endl;
+
   // Side by side: the whole 120-frame x 10-step bake of the 50 x 50 sheet, default threads, both the
   // fastest of the same number of runs. Speed against error: our run at each tolerance, its end positions
   // against a run solved to 1e-12 (RMS and largest distance over the particles, mm).
@@ -148,15 +205,9 @@ nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::
       VecX end;
       const double ours = forward_seconds(solver_scene(o.blender_n, name.str(), 120), o.repeats, &end);
       const bool ok = ours > 0 && end.size() == reference.size();
-      double rms = 0, worst = 0;
-      for (int i = 0; ok && i < int(end.size() / 3); ++i) {
-        const double d = (seg(end, i) - seg(reference, i)).norm();
-        rms += d * d;
-        worst = std::max(worst, d);
-      }
-      rms = std::sqrt(rms / std::max<Eigen::Index>(1, end.size() / 3));
+      const auto [rms, worst] = ok ? end_distance_mm(end, reference) : std::pair<double, double>{0, 0};
       side.add({std::to_string(o.blender_n), "120", "1200", fmt(tol), ok ? fmt(ours) : "nan", b > 0 ? fmt(b) : "nan",
-                ok && b > 0 ? fmt(b / ours) : "nan", ok ? fmt(1e3 * rms) : "nan", ok ? fmt(1e3 * worst) : "nan"});
+                ok && b > 0 ? fmt(b / ours) : "nan", ok ? fmt(rms) : "nan", ok ? fmt(worst) : "nan"});
     }
     // One gradient against one forward over the whole 1,200-step anchor run (the table above measures 40
     // steps, where the warm starts have less history to work with).

@@ -20,15 +20,15 @@ void add_simulate_command(CLI::App& app) {
   sub->add_option("SCENE", *scene_path, "scene file (JSON)")->required();
   sub->add_option("--out", *out, "run directory (default: out/<scene>/)");
   sub->callback([=] {
-    const Scene scene = load_scene(*scene_path);
+    Scene scene = load_scene(*scene_path);
+    if (scene.cloth) scene.cloth->use_motion_tolerance();
     auto sys = make_system(scene);
     const auto dir = run_dir_for(scene, *out);
     VecX x0, v0;
     sys->initial_state(x0, v0);
-    std::vector<VecX> U(scene.time.steps(), VecX::Zero(sys->dof()));
     Rollout r;
     const auto t0 = std::chrono::steady_clock::now();
-    const bool ok = simulate(*sys, x0, v0, U, r);
+    const bool ok = simulate_frames(*sys, x0, v0, scene.time, r);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!ok)
       throw InputError(scene.file.string() + ": the simulation diverged at step " + std::to_string(r.diverged_at) +

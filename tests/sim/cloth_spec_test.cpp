@@ -38,6 +38,16 @@ TEST(ClothSpec, DefaultsAndGridLayout) {
   EXPECT_EQ(sys.damped_springs(), 29);
 }
 
+TEST(ClothSpec, MotionToleranceOnlyWhereTheSceneStatesNone) {
+  ClothSpec unstated = *scene_with(R"({"nx": 4, "ny": 4})").cloth;
+  EXPECT_EQ(unstated.cg_tolerance, 1e-8);  // gradients
+  unstated.use_motion_tolerance();
+  EXPECT_EQ(unstated.cg_tolerance, ClothSpec::kMotionTolerance);
+  ClothSpec stated = *scene_with(R"({"nx": 4, "ny": 4, "cg_tolerance": 1e-10})").cloth;
+  stated.use_motion_tolerance();
+  EXPECT_EQ(stated.cg_tolerance, 1e-10);
+}
+
 TEST(ClothSpec, NamedAndListedPins) {
   EXPECT_EQ(scene_with(R"({"nx": 4, "ny": 3, "pins": "top_corners"})").cloth->pins, (std::vector<int>{8, 11}));
   EXPECT_EQ(scene_with(R"({"nx": 4, "ny": 3, "pins": "left_edge"})").cloth->pins, (std::vector<int>{0, 4, 8}));
@@ -53,7 +63,7 @@ TEST(ClothSpec, CollidersAndErrorsNameTheirPlace) {
   ASSERT_EQ(s.cloth->colliders.size(), 2u);
   EXPECT_EQ(std::get<TorusShape>(s.cloth->colliders[1].shape).axis, Vec3(0, 0, 1));
   EXPECT_STREQ(type_name(s.cloth->colliders[0]), "ground");
-  EXPECT_EQ(make_system(s)->describe(), "cloth: 16x16 particles, 1378 springs, 0 pinned, 2 colliders, PCG (incomplete_cholesky), exact adjoint");
+  EXPECT_EQ(make_system(s)->describe(), "cloth: 16x16 particles, 1378 springs, 0 pinned, 2 colliders, PCG (incomplete_cholesky, tolerance 1e-08), exact adjoint");
   EXPECT_EQ(scene_with(R"({"cg_preconditioner": "block_jacobi"})").cloth->cg_preconditioner, "block_jacobi");
   EXPECT_NE(error_of(R"({"cg_preconditioner": "ilu"})").find("/cloth/cg_preconditioner: expected one of"),
             std::string::npos);

@@ -1,6 +1,8 @@
 // The cloth system as a whole: assembly, conservation, rest, pins, determinism.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <iostream>
 #include <random>
 #include <tbb/global_control.h>
 
@@ -146,6 +148,34 @@ TEST(ClothSystem, ClothStaysOutsideASphereAndAboveTheGround) {
   EXPECT_GT(min_sphere, -0.01);  // within the 1 cm contact thickness
   EXPECT_GT(min_ground, -0.01);
   EXPECT_LT(min_ground, 0.02);  // it did drape down to the ground
+}
+
+// The tolerance keyframe simulate uses where a scene states none moves a hanging sheet's end state by far
+// less than the integrator's own error (the same run at half the step): 0.06 % of it here (1e-3: 0.16 %); measured in
+// tests/results/bench/solver_motion.csv at 30 x 30 as well.
+TEST(ClothSystem, MotionToleranceErrorIsFarBelowTheStepsOwn) {
+  const std::string sheet = R"({"nx": 20, "ny": 20, "origin": [-0.5, 1, -0.5], "u_axis": [1, 0, 0],
+                                "v_axis": [0, 0, 1], "pins": "bottom_edge"})";
+  auto end_state = [&](double h, double tol) {
+    ClothSpec spec = spec_from(sheet);
+    spec.cg_tolerance = tol;
+    ClothSystem sys(spec, h);
+    VecX x, v, x1, v1;
+    sys.initial_state(x, v);
+    const VecX u = VecX::Zero(x.size());
+    for (int n = 0; n < int(std::lround(1.0 / h)); ++n) {
+      EXPECT_TRUE(sys.step(n, x, v, u, x1, v1)) << "step " << n;
+      x.swap(x1);
+      v.swap(v1);
+    }
+    return x;
+  };
+  const VecX exact = end_state(1.0 / 240, 1e-12);
+  const double solve_error = (end_state(1.0 / 240, ClothSpec::kMotionTolerance) - exact).norm();
+  const double step_error = (end_state(1.0 / 480, 1e-12) - exact).norm();
+  EXPECT_GT(solve_error, 0.0);
+  std::cout << "end state: motion tolerance " << solve_error << " m, half step " << step_error << " m\n";
+  EXPECT_LT(solve_error, 0.001 * step_error) << solve_error << " against " << step_error;
 }
 
 // One forward and backward pass with a fixed number of threads.

@@ -501,10 +501,11 @@ void ClothSystem::save_step_context(int n, VecX& context) const { forward_start_
 void ClothSystem::restore_step_context(int n, const VecX& context) { forward_start_.restore(n, context); }
 
 std::string ClothSystem::describe() const {
-  std::ostringstream os;
+  std::ostringstream os, tolerance;
+  tolerance << spec_.cg_tolerance;
   os << "cloth: " << spec_.nx << "x" << spec_.ny << " particles, " << springs_.size() << " springs, "
      << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, "
-     << (direct_solve_ ? std::string("sparse ") + FilteredDirect::backend() : std::string("PCG (") + preconditioner_name(preconditioner_kind(spec_.cg_preconditioner, p_)) + ")") << ", " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
+     << (direct_solve_ ? std::string("sparse ") + FilteredDirect::backend() : std::string("PCG (") + preconditioner_name(preconditioner_kind(spec_.cg_preconditioner, p_)) + ", tolerance " + tolerance.str() + ")") << ", " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
   return os.str();
 }
 
