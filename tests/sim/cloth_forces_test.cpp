@@ -257,6 +257,33 @@ TEST(ClothDamping, JacobiansMatchFiniteDifferences) {
   }
 }
 
+// The exact adjoint's matrix-free products against the Jacobians they stand for, in tension, inside the
+// buckling blend, deep in compression, near zero length and at zero rest length.
+TEST(ClothSpring, AdjointProductsMatchTheJacobians) {
+  std::mt19937 rng(23);
+  std::normal_distribution<double> N;
+  auto close = [](const Vec3& a, const Vec3& b) { return (a - b).norm() <= 1e-13 * std::max(1.0, b.norm()); };
+  for (double rest : {0.1, 0.0})
+    for (double ratio : {1.2, 1.001, 0.999, 0.8, 0.05, 1e-10}) {
+      BucklingSpring s = test_spring();
+      s.rest = rest;
+      const VecX x = pair_at(ratio, rest > 0 ? rest : 0.1, rng);
+      VecX v(6);
+      for (int k = 0; k < 6; ++k) v[k] = N(rng);
+      const Vec3 p(N(rng), N(rng), N(rng)), q(N(rng), N(rng), N(rng));
+      for (bool derivative : {false, true}) {
+        Vec3 Bp, dpq;
+        spring_adjoint_products(s, x, derivative, p, q, Bp, dpq);
+        EXPECT_TRUE(close(Bp, spring_jacobian(s, x, false) * p)) << rest << " " << ratio;
+        EXPECT_TRUE(close(dpq, derivative ? spring_jacobian_derivative(s, x, true, p, q) : Vec3::Zero()))
+            << rest << " " << ratio;
+        const Vec3 damping = damping_jacobian_x(s, 0.3, x, v).transpose() * p +
+                             (derivative ? damping_jacobian_v_derivative(s, 0.3, x, p, q) : Vec3::Zero());
+        EXPECT_TRUE(close(damping_adjoint_products(s, 0.3, x, v, p, derivative, q), damping)) << rest << " " << ratio;
+      }
+    }
+}
+
 TEST(ClothDamping, RigidMotionIsNotDamped) {
   const BucklingSpring s = test_spring();
   std::mt19937 rng(5);

@@ -173,11 +173,11 @@ void spring_force_and_definite_jacobian(const BucklingSpring& sp, const VecX& x,
   B = dT * nn + t * (Mat3::Identity() - nn);
 }
 
-void spring_jacobian_and_definite_derivative(const BucklingSpring& sp, const VecX& x, bool derivative, const Vec3& p,
-                                             const Vec3& q, Mat3& B, Vec3& dpq) {
+void spring_adjoint_products(const BucklingSpring& sp, const VecX& x, bool derivative, const Vec3& p, const Vec3& q,
+                             Vec3& Bp, Vec3& dpq) {
   dpq.setZero();
   if (sp.rest == 0) {
-    B = sp.k * Mat3::Identity();
+    Bp = sp.k * p;
     return;
   }
   const Vec3 d = seg(x, sp.b) - seg(x, sp.a);
@@ -185,17 +185,17 @@ void spring_jacobian_and_definite_derivative(const BucklingSpring& sp, const Vec
   double T, dT, d2T;
   spring_tension(sp, s, T, dT, d2T);
   if (s <= kDegenerate * sp.rest) {
-    B = dT * Mat3::Identity();
+    Bp = dT * p;
     return;
   }
   const Vec3 n = d / s;
-  const Mat3 nn = n * n.transpose();
+  const double pn = p.dot(n);
   double t, dt;
   transverse_stiffness(sp, s, T, dT, /*definite=*/false, t, dt);
-  B = dT * nn + t * (Mat3::Identity() - nn);
+  Bp = t * p + (dT - t) * pn * n;  // dT n n^T p + t (I - n n^T) p
   if (!derivative) return;
   transverse_stiffness(sp, s, T, dT, /*definite=*/true, t, dt);
-  const double pn = p.dot(n), qn = q.dot(n);
+  const double qn = q.dot(n);
   const Vec3 dpn = (p - pn * n) / s, dqn = (q - qn * n) / s;
   dpq = ((d2T - dt) * pn * qn + dt * p.dot(q)) * n + (dT - t) * (qn * dpn + pn * dqn);
 }

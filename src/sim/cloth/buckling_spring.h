@@ -64,10 +64,10 @@ void spring_force_and_definite_jacobian(const BucklingSpring& sp, const VecX& x,
 // the derivative from the side the spring is on). Zero for degenerate and zero-rest-length springs.
 Vec3 spring_jacobian_derivative(const BucklingSpring& sp, const VecX& x, bool definite, const Vec3& p, const Vec3& q);
 
-// What the exact adjoint needs of a spring, from one evaluation of the tension: B = spring_jacobian(sp, x,
-// false) and, when `derivative` is true, dpq = spring_jacobian_derivative(sp, x, true, p, q) (else 0);
-// equal to those functions bit for bit.
-void spring_jacobian_and_definite_derivative(const BucklingSpring& sp, const VecX& x, bool derivative, const Vec3& p,
-                                             const Vec3& q, Mat3& B, Vec3& dpq);
+// What the exact adjoint needs of a spring, from one evaluation of the tension and without forming a matrix:
+// Bp = spring_jacobian(sp, x, false) p (B is symmetric) and, when `derivative` is true,
+// dpq = spring_jacobian_derivative(sp, x, true, p, q) (else 0); equal to those to round-off.
+void spring_adjoint_products(const BucklingSpring& sp, const VecX& x, bool derivative, const Vec3& p, const Vec3& q,
+                             Vec3& Bp, Vec3& dpq);
 
 }  // namespace kf

@@ -438,15 +438,11 @@ void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v,
       const BucklingSpring& s = springs_[k];
       const Vec3 dw = seg(w, s.b) - seg(w, s.a);
       const bool derivative = exact && dw.squaredNorm() > 0;
-      Mat3 G;
-      Vec3 dK;
-      spring_jacobian_and_definite_derivative(s, x, derivative, dw, seg(c_, s.b) - seg(c_, s.a), G, dK);
-      if (k < damped_) G += damping_jacobian_x(s, spec_.damping, x, v);
-      Vec3 t = G.transpose() * dw;
-      if (derivative) {
-        t += h * dK;
-        if (k < damped_) t += damping_jacobian_v_derivative(s, spec_.damping, x, dw, seg(dv, s.b) - seg(dv, s.a));
-      }
+      Vec3 t, dK;
+      spring_adjoint_products(s, x, derivative, dw, seg(c_, s.b) - seg(c_, s.a), t, dK);
+      if (derivative) t += h * dK;
+      if (k < damped_)
+        t += damping_adjoint_products(s, spec_.damping, x, v, dw, derivative, seg(dv, s.b) - seg(dv, s.a));
       spring_f_[k] = t;
     }
   });

@@ -41,4 +41,21 @@ Vec3 damping_jacobian_v_derivative(const BucklingSpring& sp, double c, const Vec
   return c * (qn * (p - pn * n) + pn * (q - qn * n)) / s;
 }
 
+Vec3 damping_adjoint_products(const BucklingSpring& sp, double c, const VecX& x, const VecX& v, const Vec3& p,
+                              bool derivative, const Vec3& q) {
+  const Vec3 d = seg(x, sp.b) - seg(x, sp.a);
+  const double s = d.norm();
+  if (s <= kDegenerate * sp.rest) return Vec3::Zero();
+  const Vec3 n = d / s, dv = seg(v, sp.b) - seg(v, sp.a);
+  // J = c (n (P dv)^T + (n . dv) P) with P = (I - n n^T) / s symmetric, so J^T p = c ((n . p) P dv + (n . dv) P p).
+  const double pn = p.dot(n), dvn = dv.dot(n);
+  const Vec3 Pp = (p - pn * n) / s;
+  Vec3 r = c * (pn * (dv - dvn * n) / s + dvn * Pp);
+  if (derivative) {
+    const double qn = q.dot(n);
+    r += c * (qn * Pp + pn * (q - qn * n) / s);  // damping_jacobian_v_derivative
+  }
+  return r;
+}
+
 }  // namespace kf

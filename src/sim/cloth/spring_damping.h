@@ -21,4 +21,9 @@ Mat3 damping_jacobian_x(const BucklingSpring& sp, double c, const VecX& x, const
 // d/dd [p . (c n n^T) q], d = x_b - x_a: the position derivative of damping_jacobian_v met by p and q.
 Vec3 damping_jacobian_v_derivative(const BucklingSpring& sp, double c, const VecX& x, const Vec3& p, const Vec3& q);
 
+// What the exact adjoint needs of the damping, without forming a matrix: damping_jacobian_x(sp, c, x, v)^T p,
+// plus damping_jacobian_v_derivative(sp, c, x, p, q) when `derivative` is true; equal to those to round-off.
+Vec3 damping_adjoint_products(const BucklingSpring& sp, double c, const VecX& x, const VecX& v, const Vec3& p,
+                              bool derivative, const Vec3& q);
+
 }  // namespace kf
