@@ -124,6 +124,8 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   }
   for (int i = 0; i < p_; ++i)
     if (!free_[i]) pinned_list_.push_back(i);
+  for (int k = 0; k < int(springs_.size()); ++k)
+    if (!free_[springs_[k].a] || !free_[springs_[k].b]) pinned_springs_.push_back(k);
 
   spring_f_.assign(springs_.size(), Vec3::Zero());
   energy_parts_.assign((springs_.size() + kSpringGrain - 1) / kSpringGrain, 0.0);
@@ -245,11 +247,14 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
   if (depth == 0) forward_start_.remember(n, dv_);
   v_next.resize(3 * p_);
   x_next.resize(3 * p_);
-  v_next = v + dv_;  // dv_ stays the solve's part: the record's dv, which the adjoint's A(x) dv terms need
-  if (kick)
-    for (int i = 0; i < p_; ++i)
-      if (free_[i]) seg(v_next, i) += (h / mass_[i]) * seg(u, i);
-  x_next = x + h * v_next;
+  // dv_ stays the solve's part: the record's dv, which the adjoint's A(x) dv terms need.
+  tbb::parallel_for(tbb::blocked_range<int>(0, p_, kParticleGrain), [&](const tbb::blocked_range<int>& r) {
+    for (int i = r.begin(); i < r.end(); ++i) {
+      seg(v_next, i) = seg(v, i) + seg(dv_, i);
+      if (kick && free_[i]) seg(v_next, i) += (h / mass_[i]) * seg(u, i);
+      seg(x_next, i) = seg(x, i) + h * seg(v_next, i);
+    }
+  }, tbb::static_partitioner());
   return res.converged && x_next.allFinite() && v_next.allFinite();
 }
 
@@ -323,8 +328,8 @@ double ClothSystem::external_work(const VecX& u, const VecX& x0, const VecX& x1,
   double w = 0;
   for (int i = 0; i < p_; ++i)
     if (control && free_[i]) w += seg(u, i).dot(seg(x1, i) - seg(x0, i));
-  for (const BucklingSpring& s : springs_) {
-    if (free_[s.a] && free_[s.b]) continue;
+  for (int k : pinned_springs_) {
+    const BucklingSpring& s = springs_[k];
     // A pin does work -f . dx against the elastic force f on its particle (trapezoidal rule).
     const Vec3 fa = 0.5 * (spring_force(s, x0) + spring_force(s, x1));
     if (!free_[s.a]) w -= fa.dot(seg(x1, s.a) - seg(x0, s.a));

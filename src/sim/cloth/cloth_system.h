@@ -157,6 +157,7 @@ class ClothSystem final : public System {
   std::unique_ptr<PinTrack> pins_;
   std::vector<char> free_;
   std::vector<int> pinned_list_;
+  std::vector<int> pinned_springs_;  // springs with a pinned end (the pins' work)
 
   // Per-step work space, sized once.
   std::vector<Vec3> spring_f_;
