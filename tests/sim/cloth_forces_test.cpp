@@ -271,15 +271,21 @@ TEST(ClothSpring, AdjointProductsMatchTheJacobians) {
       VecX v(6);
       for (int k = 0; k < 6; ++k) v[k] = N(rng);
       const Vec3 p(N(rng), N(rng), N(rng)), q(N(rng), N(rng), N(rng));
+      Vec3 f;
+      Mat3 K;
+      SpringState state;
+      spring_force_and_definite_jacobian(s, x, f, K, state);
+      EXPECT_EQ(f, spring_force(s, x));
+      EXPECT_EQ(K, spring_jacobian(s, x, true));
       for (bool derivative : {false, true}) {
         Vec3 Bp, dpq;
-        spring_adjoint_products(s, x, derivative, p, q, Bp, dpq);
+        spring_adjoint_products(s, state, derivative, p, q, Bp, dpq);
         EXPECT_TRUE(close(Bp, spring_jacobian(s, x, false) * p)) << rest << " " << ratio;
         EXPECT_TRUE(close(dpq, derivative ? spring_jacobian_derivative(s, x, true, p, q) : Vec3::Zero()))
             << rest << " " << ratio;
         const Vec3 damping = damping_jacobian_x(s, 0.3, x, v).transpose() * p +
                              (derivative ? damping_jacobian_v_derivative(s, 0.3, x, p, q) : Vec3::Zero());
-        EXPECT_TRUE(close(damping_adjoint_products(s, 0.3, x, v, p, derivative, q), damping)) << rest << " " << ratio;
+        EXPECT_TRUE(close(damping_adjoint_products(s, 0.3, state, v, p, derivative, q), damping)) << rest << " " << ratio;
       }
     }
 }

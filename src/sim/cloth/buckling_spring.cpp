@@ -150,45 +150,48 @@ Mat3 spring_jacobian(const BucklingSpring& sp, const VecX& x, bool definite) {
   return dT * nn + t * (Mat3::Identity() - nn);
 }
 
-void spring_force_and_definite_jacobian(const BucklingSpring& sp, const VecX& x, Vec3& f, Mat3& B) {
+void spring_force_and_definite_jacobian(const BucklingSpring& sp, const VecX& x, Vec3& f, Mat3& B,
+                                        SpringState& state) {
   const Vec3 d = seg(x, sp.b) - seg(x, sp.a);
+  const double s = d.norm();
+  state.s = s;
+  state.n = s > 0 ? Vec3(d / s) : Vec3::Zero();
   if (sp.rest == 0) {
     f = sp.k * d;
     B = sp.k * Mat3::Identity();
     return;
   }
-  const double s = d.norm();
   double T, dT, d2T;
   spring_tension(sp, s, T, dT, d2T);
+  state.T = T;
+  state.dT = dT;
+  state.d2T = d2T;
   if (s <= kDegenerate * sp.rest) {
     f.setZero();
     B = dT * Mat3::Identity();
     return;
   }
   f = (T / s) * d;
-  const Vec3 n = d / s;
+  const Vec3& n = state.n;
   const Mat3 nn = n * n.transpose();
   double t, dt;
   transverse_stiffness(sp, s, T, dT, /*definite=*/true, t, dt);
   B = dT * nn + t * (Mat3::Identity() - nn);
 }
 
-void spring_adjoint_products(const BucklingSpring& sp, const VecX& x, bool derivative, const Vec3& p, const Vec3& q,
-                             Vec3& Bp, Vec3& dpq) {
+void spring_adjoint_products(const BucklingSpring& sp, const SpringState& state, bool derivative, const Vec3& p,
+                             const Vec3& q, Vec3& Bp, Vec3& dpq) {
   dpq.setZero();
   if (sp.rest == 0) {
     Bp = sp.k * p;
     return;
   }
-  const Vec3 d = seg(x, sp.b) - seg(x, sp.a);
-  const double s = d.norm();
-  double T, dT, d2T;
-  spring_tension(sp, s, T, dT, d2T);
+  const double s = state.s, T = state.T, dT = state.dT, d2T = state.d2T;
   if (s <= kDegenerate * sp.rest) {
     Bp = dT * p;
     return;
   }
-  const Vec3 n = d / s;
+  const Vec3& n = state.n;
   const double pn = p.dot(n);
   double t, dt;
   transverse_stiffness(sp, s, T, dT, /*definite=*/false, t, dt);

@@ -54,9 +54,17 @@ Vec3 spring_force(const BucklingSpring& sp, const VecX& x);
 // included: its axial and transverse stiffnesses are both k, so the direction never enters.
 Mat3 spring_jacobian(const BucklingSpring& sp, const VecX& x, bool definite);
 
+// A spring's length s = |x_b - x_a|, direction n (0 when s = 0) and tension with its first two derivatives
+// at s, as the step's assembly finds them: what the adjoint's products at the same positions reuse.
+struct SpringState {
+  Vec3 n = Vec3::Zero();
+  double s = 0, T = 0, dT = 0, d2T = 0;
+};
+
 // spring_force and spring_jacobian(definite = true) from one evaluation of the tension (the step's
-// assembly needs both), equal to them bit for bit.
-void spring_force_and_definite_jacobian(const BucklingSpring& sp, const VecX& x, Vec3& f, Mat3& B);
+// assembly needs both), equal to them bit for bit; `state` receives what they were computed from.
+void spring_force_and_definite_jacobian(const BucklingSpring& sp, const VecX& x, Vec3& f, Mat3& B,
+                                        SpringState& state);
 
 // d/dd [p . B(d) q] with d = x_b - x_a (N/m^2 times the units of p q): the position derivative of the
 // spring's stiffness met by two vectors, which the exact adjoint of a step needs (the step's matrix
@@ -64,10 +72,10 @@ void spring_force_and_definite_jacobian(const BucklingSpring& sp, const VecX& x,
 // the derivative from the side the spring is on). Zero for degenerate and zero-rest-length springs.
 Vec3 spring_jacobian_derivative(const BucklingSpring& sp, const VecX& x, bool definite, const Vec3& p, const Vec3& q);
 
-// What the exact adjoint needs of a spring, from one evaluation of the tension and without forming a matrix:
-// Bp = spring_jacobian(sp, x, false) p (B is symmetric) and, when `derivative` is true,
-// dpq = spring_jacobian_derivative(sp, x, true, p, q) (else 0); equal to those to round-off.
-void spring_adjoint_products(const BucklingSpring& sp, const VecX& x, bool derivative, const Vec3& p, const Vec3& q,
-                             Vec3& Bp, Vec3& dpq);
+// What the exact adjoint needs of a spring at the positions `state` came from (spring_force_and_definite_jacobian),
+// without forming a matrix: Bp = spring_jacobian(sp, x, false) p (B is symmetric) and, when `derivative` is
+// true, dpq = spring_jacobian_derivative(sp, x, true, p, q) (else 0); equal to those to round-off.
+void spring_adjoint_products(const BucklingSpring& sp, const SpringState& state, bool derivative, const Vec3& p,
+                             const Vec3& q, Vec3& Bp, Vec3& dpq);
 
 }  // namespace kf

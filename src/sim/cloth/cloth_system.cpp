@@ -130,6 +130,7 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   spring_f_.assign(springs_.size(), Vec3::Zero());
   energy_parts_.assign((springs_.size() + kSpringGrain - 1) / kSpringGrain, 0.0);
   spring_K_.assign(springs_.size(), Mat3::Zero());
+  spring_state_.assign(springs_.size(), SpringState());
   spring_D_.assign(springs_.size(), Mat3::Zero());
   force_.setZero(3 * p_);
   rhs_.setZero(3 * p_);
@@ -162,16 +163,18 @@ void ClothSystem::initial_state(VecX& x, VecX& v) const {
   }
 }
 
-void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs) {
+void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs) { assemble(n, x, v, hs, true); }
+
+void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs, bool forces) {
   const int ns = int(springs_.size());
   // Each spring writes only its own slots.
   tbb::parallel_for(tbb::blocked_range<int>(0, ns, kSpringGrain), [&](const tbb::blocked_range<int>& r) {
     for (int k = r.begin(); k < r.end(); ++k) {
       const BucklingSpring& s = springs_[k];
-      spring_force_and_definite_jacobian(s, x, spring_f_[k], spring_K_[k]);
+      spring_force_and_definite_jacobian(s, x, spring_f_[k], spring_K_[k], spring_state_[k]);
       if (k < damped_) {
-        spring_f_[k] += damping_force(s, spec_.damping, x, v);
-        spring_D_[k] = damping_jacobian_v(s, spec_.damping, x);
+        if (forces) spring_f_[k] += damping_force(s, spec_.damping, spring_state_[k], v);
+        spring_D_[k] = damping_jacobian_v(s, spec_.damping, spring_state_[k]);
       }
     }
   });
@@ -187,7 +190,7 @@ void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs) {
       for (int e = incident_start_[i]; e < incident_start_[i + 1]; ++e) {
         const Incident& in = incident_[e];
         const Mat3& Ks = spring_K_[in.spring];
-        f += in.sign * spring_f_[in.spring];
+        if (forces) f += in.sign * spring_f_[in.spring];
         Kii -= Ks;
         if (in.spring < damped_) {
           const Mat3& Ds = spring_D_[in.spring];
@@ -422,7 +425,7 @@ void ClothSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX&,
 void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v, const VecX& dv, bool warm_ok,
                                   const VecX& xhat1, const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) {
   const bool exact = adjoint_ == AdjointKind::kExact;
-  assemble(n, x, v, h);
+  assemble(n, x, v, h, /*forces=*/false);
   rhs_ = vhat1 + h * xhat1;
   // w is zero on pinned particles (and so is every guess).
   const bool warm = warm_ok && adjoint_start_.guess(n, w_);
@@ -444,10 +447,12 @@ void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v,
       const Vec3 dw = seg(w, s.b) - seg(w, s.a);
       const bool derivative = exact && dw.squaredNorm() > 0;
       Vec3 t, dK;
-      spring_adjoint_products(s, x, derivative, dw, seg(c_, s.b) - seg(c_, s.a), t, dK);
+      // spring_state_ is this substep's: assemble() above ran at the same positions.
+      spring_adjoint_products(s, spring_state_[k], derivative, dw, seg(c_, s.b) - seg(c_, s.a), t, dK);
       if (derivative) t += h * dK;
       if (k < damped_)
-        t += damping_adjoint_products(s, spec_.damping, x, v, dw, derivative, seg(dv, s.b) - seg(dv, s.a));
+        t += damping_adjoint_products(s, spec_.damping, spring_state_[k], v, dw, derivative,
+                                      seg(dv, s.b) - seg(dv, s.a));
       spring_f_[k] = t;
     }
   });

@@ -127,6 +127,8 @@ class ClothSystem final : public System {
   // The adjoint of one linearised substep (see the header comment); adds its uhat to `uhat`.
   void substep_adjoint(int n, double hs, const VecX& x, const VecX& v, const VecX& dv, bool warm, const VecX& xhat1,
                        const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat);
+  // The same; `forces` false leaves f out (the adjoint needs the matrices alone), and force() is then stale.
+  void assemble(int n, const VecX& x, const VecX& v, double hs, bool forces);
   // Solves the assembled A on the free set (x: prescribed values on pins, warm start on free ones).
   PcgResult solve(const VecX& b, VecX& x, bool warm);
   Energy with_contact_energy(int n, const VecX& x, Energy e) const;  // e plus the colliders' part at step n
@@ -162,6 +164,7 @@ class ClothSystem final : public System {
   // Per-step work space, sized once.
   std::vector<Vec3> spring_f_;
   std::vector<Mat3> spring_K_, spring_D_;
+  std::vector<SpringState> spring_state_;     // per spring: its length, direction and tension at the last assemble
   mutable std::vector<double> energy_parts_;  // energy(): one partial sum per fixed chunk of springs
   std::vector<Mat3> contact_K_;  // per particle: the colliders' part of K's diagonal block
   BlockSparse3 A_;
