@@ -163,8 +163,6 @@ void ClothSystem::initial_state(VecX& x, VecX& v) const {
   }
 }
 
-void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs) { assemble(n, x, v, hs, true); }
-
 void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs, bool forces) {
   const int ns = int(springs_.size());
   // Each spring writes only its own slots.

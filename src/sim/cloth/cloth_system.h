@@ -87,8 +87,9 @@ class ClothSystem final : public System {
   AdjointKind adjoint() const { return adjoint_; }
 
   // Evaluates forces f and the blocks of K, D and A at (x, v) of step n for a (sub)step of length hs
-  // (default h; the forward pass does this).
-  void assemble(int n, const VecX& x, const VecX& v, double hs = 0);
+  // (default h; the forward pass does this). `forces` false leaves f out (the adjoint needs the matrices
+  // alone), and force() is then stale.
+  void assemble(int n, const VecX& x, const VecX& v, double hs = 0, bool forces = true);
   // Results of the last assemble: f (3p, N), K (N/m), D (N s/m), A (kg), as Eigen matrices (allocate).
   const VecX& force() const { return force_; }
   SpMat stiffness_matrix() const;
@@ -127,8 +128,6 @@ class ClothSystem final : public System {
   // The adjoint of one linearised substep (see the header comment); adds its uhat to `uhat`.
   void substep_adjoint(int n, double hs, const VecX& x, const VecX& v, const VecX& dv, bool warm, const VecX& xhat1,
                        const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat);
-  // The same; `forces` false leaves f out (the adjoint needs the matrices alone), and force() is then stale.
-  void assemble(int n, const VecX& x, const VecX& v, double hs, bool forces);
   // Solves the assembled A on the free set (x: prescribed values on pins, warm start on free ones).
   PcgResult solve(const VecX& b, VecX& x, bool warm);
   Energy with_contact_energy(int n, const VecX& x, Energy e) const;  // e plus the colliders' part at step n
