@@ -244,7 +244,7 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
     seg(dv_, i) = (b - seg(x, i)) / h - seg(v, i);
   }
   const PcgResult res = solve(rhs_, dv_, warm);
-  last_cg_ = res.iterations;
+  last_cg_ += res.iterations;
   if (depth == 0) forward_start_.remember(n, dv_);
   v_next.resize(3 * p_);
   x_next.resize(3 * p_);
@@ -388,6 +388,7 @@ bool ClothSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
                        StepRecord& record) {
   ClothRecord& rec = static_cast<ClothRecord&>(record);
   rec.count = 0;
+  last_cg_ = 0;
   const bool ok = checked_step(n, 0, 0.0, x, v, u, x_next, v_next, rec);
   last_substeps_ = rec.count;
   // The next step starts warm only from an unsplit step's solution.

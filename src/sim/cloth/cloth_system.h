@@ -113,7 +113,8 @@ class ClothSystem final : public System {
   // The same without the colliders' part (which depends on n).
   Energy state_energy(const VecX& x, const VecX& v) const;
   Vec3 stiffness_times_velocity(int i, const VecX& v) const;
-  // PCG iterations of the last forward / backward solve (benchmarks, logs).
+  // PCG iterations of the last forward step (all its solves, a split step's rejected ones too) / of the last
+  // backward solve (benchmarks, logs).
   int last_cg_iterations() const { return last_cg_; }
   int last_adjoint_cg_iterations() const { return last_adjoint_cg_; }
 
