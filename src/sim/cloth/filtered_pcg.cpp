@@ -66,7 +66,7 @@ void FilteredPcg::prepare(const BlockSparse3& A, const std::vector<char>& free) 
     if (mg_ok_) return;
   }
   if (kind_ == Preconditioner::kIncompleteCholesky) {
-    if (!ic_.analysed_for(A)) ic_.analyse(A);  // the pattern is the sheet's: its order is made once
+    if (!ic_.analysed_for(A)) ic_.analyse(A, ic_keep_);  // the pattern is the sheet's: its order is made once
     ic_ok_ = ic_.factor(A, free);
     if (ic_ok_) return;
   }

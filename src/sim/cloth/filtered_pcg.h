@@ -28,6 +28,8 @@ class FilteredPcg {
  public:
   // Preallocates for p particles; multigrid needs the grid (p = nx ny).
   void resize(int p, Preconditioner kind = Preconditioner::kIncompleteCholesky, int nx = 0, int ny = 0);
+  // The blocks of A the incomplete Cholesky factor keeps (one entry per block; empty, the default: all).
+  void set_factor_pattern(std::vector<char> keep) { ic_keep_ = std::move(keep); ic_ = IncompleteCholesky(); }
   // Builds the preconditioner from A (symmetric, blocks A_ji = A_ij^T) on free particles. Call after A
   // changes, before solve.
   void prepare(const BlockSparse3& A, const std::vector<char>& free);
@@ -55,6 +57,7 @@ class FilteredPcg {
   int nx_ = 0, ny_ = 0;
   GridMultigrid mg_;
   IncompleteCholesky ic_;
+  std::vector<char> ic_keep_;
   std::vector<Mat3> inv_diag_;  // block Jacobi: A_ii^-1
   VecX r_, z_, p_, q_;
   std::vector<double> partial_;  // one partial sum per chunk

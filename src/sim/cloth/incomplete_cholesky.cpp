@@ -14,12 +14,12 @@ namespace {
 // Below this many particles one thread does the whole factor: a split saves less than it costs.
 constexpr int kSplitFrom = 512;
 
-// The particles at or after `mid` with a neighbour before it.
-std::vector<int> separator_after(const BlockSparse3& A, int mid) {
+// The particles at or after `mid` with a kept neighbour before it.
+std::vector<int> separator_after(const BlockSparse3& A, const std::vector<char>& keep, int mid) {
   std::vector<int> s;
   for (int i = mid; i < A.block_rows(); ++i)
     for (int k = A.row_start(i); k < A.row_start(i + 1); ++k)
-      if (A.col(k) < mid) {
+      if (A.col(k) < mid && (keep.empty() || keep[k])) {
         s.push_back(i);
         break;
       }
@@ -39,7 +39,7 @@ void IncompleteCholesky::halves(F&& f) const {
       tbb::static_partitioner());
 }
 
-void IncompleteCholesky::analyse(const BlockSparse3& A) {
+void IncompleteCholesky::analyse(const BlockSparse3& A, const std::vector<char>& keep) {
   const int n = A.block_rows();
   a_blocks_ = A.nonzero_blocks();
   order_.clear();
@@ -47,9 +47,9 @@ void IncompleteCholesky::analyse(const BlockSparse3& A) {
   int mid = n;
   if (n >= kSplitFrom) {
     // Balance the halves: the separator comes out of the second one.
-    const int width = int(separator_after(A, n / 2).size());
+    const int width = int(separator_after(A, keep, n / 2).size());
     mid = (n - width) / 2;
-    const std::vector<int> s = separator_after(A, mid);
+    const std::vector<int> s = separator_after(A, keep, mid);
     if (int(s.size()) <= n / 8)
       for (int i : s) in_separator[i] = 1;
     else
@@ -74,7 +74,7 @@ void IncompleteCholesky::analyse(const BlockSparse3& A) {
     const int i = order_[q];
     row.clear();
     for (int k = A.row_start(i); k < A.row_start(i + 1); ++k)
-      if (position_[A.col(k)] < q) row.emplace_back(position_[A.col(k)], k);
+      if (position_[A.col(k)] < q && (keep.empty() || keep[k])) row.emplace_back(position_[A.col(k)], k);
     std::sort(row.begin(), row.end());
     for (const auto& [c, k] : row) {
       col_pos_.push_back(c);
