@@ -46,6 +46,7 @@ void FilteredPcg::resize(int p, Preconditioner kind, int nx, int ny) {
   ny_ = ny;
   mg_ready_ = false;
   ic_ = IncompleteCholesky();  // analysed again at the first prepare
+  ic_keep_.clear();
   if (kind == Preconditioner::kMultigrid && nx * ny != p) kind_ = Preconditioner::kIncompleteCholesky;
   inv_diag_.assign(p, Mat3::Identity());
   r_.setZero(3 * p);

@@ -29,6 +29,7 @@ class FilteredPcg {
   // Preallocates for p particles; multigrid needs the grid (p = nx ny).
   void resize(int p, Preconditioner kind = Preconditioner::kIncompleteCholesky, int nx = 0, int ny = 0);
   // The blocks of A the incomplete Cholesky factor keeps (one entry per block; empty, the default: all).
+  // Call after resize, which forgets it.
   void set_factor_pattern(std::vector<char> keep) { ic_keep_ = std::move(keep); ic_ = IncompleteCholesky(); }
   // Builds the preconditioner from A (symmetric, blocks A_ji = A_ij^T) on free particles. Call after A
   // changes, before solve.
