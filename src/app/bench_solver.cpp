@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <sstream>
 #include <tbb/global_control.h>
 
@@ -50,7 +51,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 // One uncontrolled forward simulation of the scene (s, fastest of `repeats`); -1 when it diverged. `end`:
 // the last state's positions.
-double forward_seconds(const Scene& scene, int repeats, VecX* end = nullptr) {
+double forward_seconds(const Scene& scene, int repeats, VecX* end = nullptr,
+                       std::vector<std::pair<std::string, double>>* stats = nullptr) {
   double best = 1e300;
   for (int r = 0; r < repeats; ++r) {
     auto sys = make_system(scene);
@@ -61,8 +63,16 @@ double forward_seconds(const Scene& scene, int repeats, VecX* end = nullptr) {
     if (!simulate_frames(*sys, x0, v0, scene.time, roll)) return -1;
     best = std::min(best, seconds_since(t0));
     if (end) *end = roll.x.back();
+    if (stats) *stats = sys->run_stats();
   }
   return best;
+}
+
+// A run statistic by name (NaN when the system did not report it).
+double stat(const std::vector<std::pair<std::string, double>>& stats, const std::string& name) {
+  for (const auto& [n, value] : stats)
+    if (n == name) return value;
+  return std::numeric_limits<double>::quiet_NaN();
 }
 
 // Blender's bake of the same sheet (s), through the anchor script; -1 when blender or the script is missing.
@@ -191,20 +201,24 @@ nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::
     // The whole bake at 100 x 100 against the 50 x 50 one, the way `keyframe simulate` runs both (its
     // default tolerance and preconditioner), repeats interleaved: the sweep below compares 40 steps, the
     // start of the swing, which is the cheap part at 100 x 100 (fewer PCG iterations and no split steps).
-    CsvTable bake({"n", "particles", "steps", "forward_s", "ms_per_step", "over_first"});
+    // The split steps and iterations say where the larger sheet's extra time goes (the same every repeat).
+    CsvTable bake({"n", "particles", "steps", "forward_s", "ms_per_step", "over_first", "split_steps",
+                   "pcg_iterations_per_step"});
     {
       const std::vector<int> sizes = {o.blender_n, 2 * o.blender_n};
       std::vector<double> best(sizes.size(), 1e300);
+      std::vector<std::vector<std::pair<std::string, double>>> stats(sizes.size());
       for (int r = 0; r < o.repeats; ++r)
         for (size_t k = 0; k < sizes.size(); ++k) {
           std::cerr << "bench solver: whole bake, n = " << sizes[k] << std::endl;
-          const double s = forward_seconds(solver_scene(sizes[k], "auto-1e-4", 120), 1);
+          const double s = forward_seconds(solver_scene(sizes[k], "auto-1e-4", 120), 1, nullptr, &stats[k]);
           best[k] = s < 0 || best[k] < 0 ? -1 : std::min(best[k], s);
         }
       for (size_t k = 0; k < sizes.size(); ++k) {
         const bool ok = best[k] > 0 && best[0] > 0;
         bake.add({std::to_string(sizes[k]), std::to_string(sizes[k] * sizes[k]), "1200", ok ? fmt(best[k]) : "nan",
-                  ok ? fmt(1e3 * best[k] / 1200) : "nan", ok ? fmt(best[k] / best[0]) : "nan"});
+                  ok ? fmt(1e3 * best[k] / 1200) : "nan", ok ? fmt(best[k] / best[0]) : "nan",
+                  fmt(stat(stats[k], "split_steps")), fmt(stat(stats[k], "pcg_iterations_per_step"))});
       }
     }
     bake.write(out / "solver_bake.csv");

@@ -67,7 +67,9 @@ struct ThrowOutcome {
   double e0 = 0, kinetic0 = 0;    // initial total and kinetic energy, J
   double highest = 0;             // highest total energy met, J
   double travelled = 0, worst_strain = 0;
-  int substeps = 0;
+  int substeps = 0, split_steps = 0;
+  double cg_iterations = 0;
+  std::vector<std::pair<std::string, double>> stats;  // the system's run_stats after the throw
   Rollout r;
 };
 
@@ -96,6 +98,8 @@ ThrowOutcome run_throw(const ThrowCase& c, int max_halvings) {
       return o;
     }
     o.substeps += sys.last_substeps();
+    o.split_steps += sys.last_substeps() > 1;
+    o.cg_iterations += sys.last_cg_iterations();
     o.highest = std::max(o.highest, sys.energy(n + 1, x1, v1).total());
     for (int i = 0; i < sys.particles(); ++i) o.travelled = std::max(o.travelled, (seg(x1, i) - seg(x, i)).norm());
     for (const BucklingSpring& s : sys.springs())
@@ -104,6 +108,7 @@ ThrowOutcome run_throw(const ThrowCase& c, int max_halvings) {
     o.r.x.push_back(std::move(x1));
     o.r.v.push_back(std::move(v1));
   }
+  o.stats = sys.run_stats();
   return o;
 }
 
@@ -126,6 +131,13 @@ TEST_P(ClothLargeStep, RunsSeventyTwoFramesWithoutGainingEnergy) {
   // definite Jacobian's transverse stiffness, faded in over strains up to kTransverseRamp, is nearly off);
   // tests/results/stability/large_step.csv has the counts.
   EXPECT_LE(o.substeps, 48 * 72) << name_of(c);
+  // The run report counts the same splits and iterations as the steps did.
+  ASSERT_EQ(o.stats.size(), 2u);
+  EXPECT_EQ(o.stats[0].first, "split_steps");
+  EXPECT_EQ(o.stats[0].second, o.split_steps);
+  EXPECT_EQ(o.split_steps > 0, o.substeps > 72);
+  EXPECT_EQ(o.stats[1].first, "pcg_iterations_per_step");
+  EXPECT_DOUBLE_EQ(o.stats[1].second, o.cg_iterations / 72);
 }
 
 std::vector<ThrowCase> all_cases() {

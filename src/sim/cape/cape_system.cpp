@@ -146,6 +146,7 @@ std::vector<std::pair<std::string, double>> CapeSystem::run_stats() const {
       {"max_self_contacts", max_self}, {"contact_steps", contact_steps}, {"cape_length", cape_length_}};
   // Only a distance some query measured: without one there is nothing to report.
   if (std::isfinite(min_distance)) stats.emplace_back("min_body_distance", min_distance);
+  for (auto& s : cloth_->run_stats()) stats.push_back(std::move(s));
   return stats;
 }
 

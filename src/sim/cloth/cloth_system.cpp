@@ -397,9 +397,28 @@ bool ClothSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
   last_cg_ = 0;
   const bool ok = checked_step(n, 0, 0.0, x, v, u, x_next, v_next, rec);
   last_substeps_ = rec.count;
+  if (n >= int(step_substeps_.size())) {  // grows during the first run only
+    step_substeps_.resize(n + 1, 0);
+    step_cg_.resize(n + 1, 0);
+  }
+  step_substeps_[n] = ok ? rec.count : 0;
+  step_cg_[n] = last_cg_;
   // The next step starts warm only from an unsplit step's solution.
   if (!ok || rec.count != 1) forward_start_.forget();
   return ok;
+}
+
+std::vector<std::pair<std::string, double>> ClothSystem::run_stats() const {
+  double steps = 0, split = 0, cg = 0;
+  for (size_t n = 0; n < step_substeps_.size(); ++n) {
+    if (step_substeps_[n] == 0) continue;
+    ++steps;
+    split += step_substeps_[n] > 1;
+    cg += step_cg_[n];
+  }
+  std::vector<std::pair<std::string, double>> stats = {{"split_steps", split}};
+  if (!direct_solve_ && steps > 0) stats.emplace_back("pcg_iterations_per_step", cg / steps);
+  return stats;
 }
 
 void ClothSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX&, const StepRecord& record,

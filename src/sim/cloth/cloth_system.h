@@ -79,6 +79,9 @@ class ClothSystem final : public System {
   void step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const StepRecord& record, const VecX& xhat1,
                     const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) override;
   std::string describe() const override;
+  // Over the steps of the forward runs so far (each step counted once, the last time it ran): split_steps,
+  // the steps the energy check split, and pcg_iterations_per_step (forward solves, rejected ones included).
+  std::vector<std::pair<std::string, double>> run_stats() const override;
   // The PCG warm start of step n (the last forward solutions when they were those of steps n-1, n-2, n-3).
   void save_step_context(int n, VecX& context) const override;
   void restore_step_context(int n, const VecX& context) override;
@@ -181,6 +184,7 @@ class ClothSystem final : public System {
   std::vector<VecX> split_x_, split_v_;  // per depth: the state between two halves of a split step
   VecX adj_x_, adj_v_, adj_u_;           // adjoint of one substep (walking split steps back)
   int last_substeps_ = 0;
+  std::vector<int> step_substeps_, step_cg_;  // per step n of the runs so far (0: not run)
   VecX energy_x_, energy_v_;  // the state whose collider-free energy is cached_energy_
   VecX solved_x_, solved_v_;  // with explicit controls: a substep's end without the kick, which the check measures
   Energy cached_energy_;
