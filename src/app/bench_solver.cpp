@@ -26,8 +26,8 @@ namespace {
 // 10 steps a frame. `solver`: "direct", or a PCG preconditioner with an optional tolerance (default the
 // scene default 1e-8): "pcg[-TOL]" (IC(0)), "mg[-TOL]" (multigrid), "auto[-TOL]" (the scene default: IC(0)
 // below 15,000 particles, multigrid from there). A position keyframe at the last frame gives the gradient
-// something to carry.
-Scene solver_scene(int n, const std::string& solver, int frames) {
+// something to carry. `cloth_keys`: more keys of the cloth block (", ..." or empty).
+Scene solver_scene(int n, const std::string& solver, int frames, int substeps = 10, const std::string& cloth_keys = "") {
   std::string extra = R"("solver": "direct")";
   if (solver != "direct") {
     const auto dash = solver.find('-');
@@ -36,9 +36,9 @@ Scene solver_scene(int n, const std::string& solver, int frames) {
     extra = R"("solver": "pcg", "cg_preconditioner": ")" + pre + R"(", "cg_tolerance": )" + tol;
   }
   const std::string text = R"({
-    "time": {"fps": 24, "substeps": 10, "frames": )" + std::to_string(frames) + R"(},
+    "time": {"fps": 24, "substeps": )" + std::to_string(substeps) + R"(, "frames": )" + std::to_string(frames) + R"(},
     "cloth": {"nx": )" + std::to_string(n) + R"(, "ny": )" + std::to_string(n) + R"(, "width": 1.0, "height": 1.0,
-              "origin": [-0.5, 1, -0.5], "u_axis": [1, 0, 0], "v_axis": [0, 0, 1], "pins": "bottom_edge", )" + extra + R"(},
+              "origin": [-0.5, 1, -0.5], "u_axis": [1, 0, 0], "v_axis": [0, 0, 1], "pins": "bottom_edge", )" + extra + cloth_keys + R"(},
     "objectives": [{"type": "center_of_mass", "frame": )" + std::to_string(frames) + R"(, "target": [0, 0.8, 0], "weight": 10}],
     "controls": {"kind": "per_frame", "alpha": 0.001}
   })";
@@ -49,9 +49,9 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// One uncontrolled forward simulation of the scene (s, fastest of `repeats`); -1 when it diverged. `end`:
-// the last state's positions.
-double forward_seconds(const Scene& scene, int repeats, VecX* end = nullptr,
+// One uncontrolled forward simulation of the scene (s, fastest of `repeats`); -1 when it diverged. `run`:
+// its frames (simulate_frames keeps every substeps-th state).
+double forward_seconds(const Scene& scene, int repeats, Rollout* run = nullptr,
                        std::vector<std::pair<std::string, double>>* stats = nullptr) {
   double best = 1e300;
   for (int r = 0; r < repeats; ++r) {
@@ -62,7 +62,7 @@ double forward_seconds(const Scene& scene, int repeats, VecX* end = nullptr,
     const auto t0 = std::chrono::steady_clock::now();
     if (!simulate_frames(*sys, x0, v0, scene.time, roll)) return -1;
     best = std::min(best, seconds_since(t0));
-    if (end) *end = roll.x.back();
+    if (run) *run = std::move(roll);
     if (stats) *stats = sys->run_stats();
   }
   return best;
@@ -102,6 +102,19 @@ std::pair<double, double> end_distance_mm(const VecX& a, const VecX& b) {
     worst = std::max(worst, d);
   }
   return {1e3 * std::sqrt(rms / std::max(1, p)), 1e3 * worst};
+}
+
+// How far one run's frames are from another's (each keeps every substeps-th state): per frame the RMS
+// distance over the particles (mm); returns the mean over the frames after the first and the largest.
+std::pair<double, double> frames_distance_mm(const Rollout& a, int a_substeps, const Rollout& b, int b_substeps,
+                                             int frames) {
+  double sum = 0, worst = 0;
+  for (int f = 1; f <= frames; ++f) {
+    const double rms = end_distance_mm(a.x[f * a_substeps], b.x[f * b_substeps]).first;
+    sum += rms;
+    worst = std::max(worst, rms);
+  }
+  return {sum / frames, worst};
 }
 
 // What a motion needs of the step's solve: three 30 x 30 sheets over 2 s (hanging from one edge as the
@@ -173,12 +186,12 @@ nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::
     // Each repeat runs Blender's bake and then ours at every tolerance, so that drift in the shared machine's
     // speed over the run reaches both sides alike (our bake timed 1.33 s at the end of a full sweep and
     // 1.0 s on its own minutes later, the same binary).
-    VecX reference;
+    Rollout reference;
     forward_seconds(solver_scene(o.blender_n, "pcg-1e-12", 120), 1, &reference);
     const int tols = int(o.blender_tolerances.size());
     double b = 1e300;
     std::vector<double> ours_best(tols, 1e300);
-    std::vector<VecX> ends(tols);
+    std::vector<Rollout> ends(tols);
     for (int r = 0; r < o.repeats; ++r) {
       if (b > 0) b = std::min(b, blender_seconds(o.blender_script, o.blender_n, out));
       for (int t = 0; t < tols; ++t) {
@@ -192,9 +205,8 @@ nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::
     CsvTable side({"n", "frames", "steps", "tolerance", "ours_s", "blender_s", "blender_over_ours", "rms_mm", "max_mm"});
     for (int t = 0; t < tols; ++t) {
       const double tol = o.blender_tolerances[t], ours = ours_best[t];
-      const VecX& end = ends[t];
-      const bool ok = ours > 0 && end.size() == reference.size();
-      const auto [rms, worst] = ok ? end_distance_mm(end, reference) : std::pair<double, double>{0, 0};
+      const bool ok = ours > 0 && !ends[t].x.empty() && ends[t].x.back().size() == reference.x.back().size();
+      const auto [rms, worst] = ok ? end_distance_mm(ends[t].x.back(), reference.x.back()) : std::pair<double, double>{0, 0};
       side.add({std::to_string(o.blender_n), "120", "1200", fmt(tol), ok ? fmt(ours) : "nan", b > 0 ? fmt(b) : "nan",
                 ok && b > 0 ? fmt(b / ours) : "nan", ok ? fmt(rms) : "nan", ok ? fmt(worst) : "nan"});
     }
@@ -223,6 +235,38 @@ nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::
     }
     bake.write(out / "solver_bake.csv");
     std::cout << "solver_bake.csv\n" << bake.excerpt() << std::endl;
+    // Speed against error for cloth.transverse_ramp, the strain over which a stretched spring's transverse
+    // stiffness fades into the step's matrix (below it, part of that stiffness acts explicitly): the same
+    // whole bakes at each ramp, their frames against a run with 8 times the steps (default ramp, 1e-6).
+    CsvTable ramps({"n", "transverse_ramp", "forward_s", "ms_per_step", "over_default", "split_steps",
+                    "pcg_iterations_per_step", "frame_rms_mm", "worst_frame_mm"});
+    {
+      const std::vector<double> widths = {0.05, 0.035, 0.02, 0.01, 0.005};  // the default first
+      for (int n : {o.blender_n, 2 * o.blender_n}) {
+        std::cerr << "bench solver: transverse ramp, n = " << n << ", reference" << std::endl;
+        Rollout fine;
+        const bool fine_ok = forward_seconds(solver_scene(n, "auto-1e-6", 120, 80), 1, &fine) > 0;
+        std::vector<double> best(widths.size(), 1e300);
+        std::vector<Rollout> runs(widths.size());
+        std::vector<std::vector<std::pair<std::string, double>>> stats(widths.size());
+        for (int r = 0; r < o.repeats; ++r)
+          for (size_t k = 0; k < widths.size(); ++k) {
+            std::cerr << "bench solver: transverse ramp, n = " << n << ", " << widths[k] << std::endl;
+            const std::string keys = ", \"transverse_ramp\": " + fmt(widths[k]);
+            const double s = forward_seconds(solver_scene(n, "auto-1e-4", 120, 10, keys), 1, &runs[k], &stats[k]);
+            best[k] = s < 0 || best[k] < 0 ? -1 : std::min(best[k], s);
+          }
+        for (size_t k = 0; k < widths.size(); ++k) {
+          const bool ok = best[k] > 0 && best[0] > 0 && fine_ok;
+          const auto [rms, worst] = ok ? frames_distance_mm(runs[k], 10, fine, 80, 120) : std::pair<double, double>{0, 0};
+          ramps.add({std::to_string(n), fmt(widths[k]), ok ? fmt(best[k]) : "nan", ok ? fmt(1e3 * best[k] / 1200) : "nan",
+                     ok ? fmt(best[k] / best[0]) : "nan", fmt(stat(stats[k], "split_steps")),
+                     fmt(stat(stats[k], "pcg_iterations_per_step")), ok ? fmt(rms) : "nan", ok ? fmt(worst) : "nan"});
+        }
+      }
+    }
+    ramps.write(out / "solver_transverse_ramp.csv");
+    std::cout << "solver_transverse_ramp.csv\n" << ramps.excerpt() << std::endl;
     // One gradient against one forward over the whole 1,200-step anchor run (the sweep below measures 40
     // steps, where the warm starts have less history to work with).
     CsvTable anchor({"n", "frames", "steps", "threads", "forward_s", "gradient_s", "gradient_over_forward"});

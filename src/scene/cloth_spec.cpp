@@ -140,6 +140,7 @@ ClothSpec parse_cloth_spec(Block& b) {
   s.control_integration = b.string("control_integration", s.control_integration, {"implicit", "explicit"});
   s.max_halvings = b.integer("max_halvings", s.max_halvings, 0, 16);
   s.contact_ramp = b.number("contact_ramp", s.contact_ramp, 0.0, 1.0);
+  s.transverse_ramp = b.number("transverse_ramp", s.transverse_ramp, 1e-4, 1.0);
   for (Block& c : b.array("colliders")) s.colliders.push_back(parse_collider(std::move(c)));
   b.finish();
   return s;

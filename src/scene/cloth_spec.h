@@ -90,6 +90,11 @@ struct ClothSpec {
   // Every contact's stiffness rises from 0 to full over this fraction of its thickness (ContactProfile);
   // 0: the linear penalty, whose stiffness jumps where contact begins.
   double contact_ramp = 0.5;
+  // The strain over which a stretched spring's transverse stiffness T/s fades into the step's matrix
+  // (BucklingSpring::transverse_ramp); below it part of that stiffness acts explicitly within the step.
+  // Narrower: more of it implicit, so light particles on taut springs stop chattering (fewer PCG
+  // iterations and split steps) but the sheet's motion is damped more (README, Cloth solver speed).
+  double transverse_ramp = 0.05;
   std::vector<ColliderSpec> colliders;
 
   int particles() const { return nx * ny; }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "scene/cloth_spec.h"
 #include "sim/cloth/air_drag.h"
 #include "sim/cloth/buckling_spring.h"
 #include "sim/cloth/spring_damping.h"
@@ -210,6 +211,43 @@ TEST(ClothSpring, DefiniteJacobianIsPositiveSemidefinite) {
     EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-12) << "ratio " << ratio;
     Eigen::SelfAdjointEigenSolver<Mat3> exact(spring_jacobian(s, x, false));
     if (ratio < 1) EXPECT_LT(exact.eigenvalues().minCoeff(), 0);  // what the definite form removes
+  }
+}
+
+// The definite transverse stiffness fades in over the spring's own ramp (the scene's transverse_ramp): half
+// of T/s halfway up it (the smoothstep's midpoint), all of it beyond, none at rest; and the position
+// derivative the exact adjoint uses matches central differences of p . B q inside the ramp, at two steps.
+TEST(ClothSpring, DefiniteTransverseStiffnessFadesInOverTheSpringsRamp) {
+  EXPECT_EQ(ClothSpec().transverse_ramp, kTransverseRamp);
+  std::mt19937 rng(29);
+  std::normal_distribution<double> N;
+  for (double ramp : {kTransverseRamp, 0.004}) {
+    BucklingSpring s = test_spring();
+    s.transverse_ramp = ramp;
+    for (double strain : {0.5 * ramp, 2 * ramp}) {
+      const VecX x = pair_at(1 + strain, s.rest, rng);
+      const Vec3 n = (seg(x, 1) - seg(x, 0)).normalized();
+      const Vec3 t = n.cross(Vec3(N(rng), N(rng), N(rng))).normalized();  // transverse
+      const double T = s.k * strain * s.rest, length = (1 + strain) * s.rest;
+      const double fade = strain < ramp ? 0.5 : 1.0;
+      EXPECT_NEAR(t.dot(spring_jacobian(s, x, true) * t), fade * T / length, 1e-9 * T / length) << ramp << " " << strain;
+      EXPECT_NEAR(t.dot(spring_jacobian(s, x, false) * t), T / length, 1e-9 * T / length);
+    }
+    const VecX x = pair_at(1 + 0.3 * ramp, s.rest, rng);
+    const Vec3 p(N(rng), N(rng), N(rng)), q(N(rng), N(rng), N(rng));
+    const Vec3 d = spring_jacobian_derivative(s, x, true, p, q);
+    ASSERT_GT(d.norm(), 0);
+    for (double step : {1e-3, 1e-4}) {
+      const double eps = step * ramp * s.rest;  // well inside the ramp
+      Vec3 fd;
+      for (int k = 0; k < 3; ++k) {
+        VecX xp = x, xm = x;
+        xp[3 + k] += eps;
+        xm[3 + k] -= eps;
+        fd[k] = (p.dot(spring_jacobian(s, xp, true) * q) - p.dot(spring_jacobian(s, xm, true) * q)) / (2 * eps);
+      }
+      EXPECT_LT((d - fd).norm(), 1e-6 * d.norm()) << "ramp " << ramp << ", step " << step;
+    }
   }
 }
 

@@ -35,11 +35,12 @@ struct Study {
   double cosine, relative_error;
 };
 
-Study study(double h, AdjointKind adjoint) {
+// `cloth_keys`: more keys of the cloth block (", ..." or empty).
+Study study(double h, AdjointKind adjoint, const std::string& cloth_keys = "") {
   const Scene scene = parse_scene(R"({"time": {"fps": 60, "frames": 40},
       "cloth": {"nx": 6, "ny": 6, "width": 0.5, "height": 0.5, "mass": 0.1, "pins": "top_corners",
                 "stretch": 200, "shear": 20, "bend": 2, "damping": 0.02, "air_drag": 0.2,
-                "velocity": [0, 0, 0.4], "cg_tolerance": 1e-12, "cg_max_iterations": 5000}})",
+                "velocity": [0, 0, 0.4], "cg_tolerance": 1e-12, "cg_max_iterations": 5000)" + cloth_keys + "}}",
                                   "gradient.json");
   auto sys = make_system(scene, h);
   dynamic_cast<ClothSystem&>(*sys).set_adjoint(adjoint);
@@ -112,6 +113,16 @@ TEST(ClothGradient, ExactAdjointMatchesFiniteDifferencesAndSwapImprovesAsStepFal
   for (size_t i = 1; i < swap.size(); ++i) {
     EXPECT_GT(swap[i].cosine, swap[i - 1].cosine) << "h = " << hs[i];
     EXPECT_LT(swap[i].relative_error, swap[i - 1].relative_error) << "h = " << hs[i];
+  }
+}
+
+// The same with a narrow transverse ramp (the scene's transverse_ramp): the exact adjoint's derivative of the
+// step's matrix follows the spring's own ramp.
+TEST(ClothGradient, ExactAdjointMatchesFiniteDifferencesWithANarrowTransverseRamp) {
+  for (double h : {1.0 / 30, 1.0 / 60}) {
+    const Study s = study(h, AdjointKind::kExact, R"(, "transverse_ramp": 0.002)");
+    std::printf("  h = 1/%.0f, transverse_ramp 0.002: exact rel. error %.3e\n", 1 / h, s.relative_error);
+    EXPECT_LT(s.relative_error, 1e-6) << "h = " << h;
   }
 }
 

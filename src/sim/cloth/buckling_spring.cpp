@@ -9,7 +9,7 @@ namespace {
 constexpr double kDegenerate = 1e-9;
 
 // The transverse stiffness t (N/m) of B and its slope dt/ds at length s with tension T, slope dT.
-// Exact: T/s. Definite: 0 in compression, T/s from a strain of kTransverseRamp on, and T/s faded in by a
+// Exact: T/s. Definite: 0 in compression, T/s from a strain of sp.transverse_ramp on, and T/s faded in by a
 // smoothstep in between: never negative, so -K stays semi-definite, and C1 in s (a plain cut at the rest
 // length puts a kink into the step map at every spring that crosses it, and the optimiser stalls on
 // them). It adds no stiffness the force does not have, so it damps nothing.
@@ -18,7 +18,7 @@ void transverse_stiffness(const BucklingSpring& sp, double s, double T, double d
   t = T / s;
   dt = (dT - T / s) / s;
   if (!definite) return;
-  const double ramp = kTransverseRamp * sp.rest, e = s - sp.rest;
+  const double ramp = sp.transverse_ramp * sp.rest, e = s - sp.rest;
   if (e <= 0) {
     t = dt = 0;
   } else if (e < ramp) {

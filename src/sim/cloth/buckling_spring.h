@@ -20,8 +20,8 @@ namespace kf {
 // response's own length scale F_b / (k - k_p).
 inline constexpr double kBuckleBlend = 0.5;
 
-// The definite Jacobian fades the transverse stiffness in over strains 0 .. kTransverseRamp (see
-// spring_jacobian).
+// The definite Jacobian fades the transverse stiffness in over strains 0 .. transverse_ramp (see
+// spring_jacobian); this is its default (the scene key cloth.transverse_ramp).
 inline constexpr double kTransverseRamp = 0.05;
 
 struct BucklingSpring {
@@ -30,6 +30,7 @@ struct BucklingSpring {
   double k = 0.0;            // tension stiffness, N/m
   double k_post = 0.0;       // post-buckling stiffness k_p <= k, N/m
   double f_buckle = 0.0;     // buckling load F_b > 0, N (0: linear in compression too)
+  double transverse_ramp = kTransverseRamp;  // strain over which the definite transverse stiffness fades in
 };
 
 // Tension T (N, positive pulls the ends together), its slope dT/ds (N/m, always >= 0) and curvature
@@ -46,7 +47,7 @@ Vec3 spring_force(const BucklingSpring& sp, const VecX& x);
 
 // B = d(force on a)/d(x_b) (3x3, N/m). The spring's 6x6 stiffness is [[-B, B], [B, -B]] (B symmetric).
 // `definite` keeps the transverse term T/s only in tension, faded in smoothly over strains
-// 0 .. kTransverseRamp (never negative, so -K is positive semi-definite and the implicit matrix SPD;
+// 0 .. sp.transverse_ramp (never negative, so -K is positive semi-definite and the implicit matrix SPD;
 // C1, so the step map has no kink where a spring passes its rest length); the exact Jacobian is
 // definite = false.
 // Springs shorter than 1e-9 L (L > 0) have no direction: force 0 and B = dT/ds I (finite, never NaN).

@@ -72,6 +72,7 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
     s.k = k;
     s.k_post = spec.buckle_stiffness * k;
     s.f_buckle = k * s.rest * spec.buckle_strain;
+    s.transverse_ramp = spec.transverse_ramp;
     springs_.push_back(s);
   };
   // Type 1 (damped): structural, then shear.
