@@ -215,7 +215,7 @@ TEST(ClothSpring, DefiniteJacobianIsPositiveSemidefinite) {
 }
 
 // The definite transverse stiffness fades in over the spring's own ramp (the scene's transverse_ramp): half
-// of T/s halfway up it (the smoothstep's midpoint), all of it beyond, none at rest; and the position
+// of T/s halfway up it (the smoothstep's midpoint), all of it beyond; and the position
 // derivative the exact adjoint uses matches central differences of p . B q inside the ramp, at two steps.
 TEST(ClothSpring, DefiniteTransverseStiffnessFadesInOverTheSpringsRamp) {
   EXPECT_EQ(ClothSpec().transverse_ramp, kTransverseRamp);

@@ -12,7 +12,8 @@ constexpr double kDegenerate = 1e-9;
 // Exact: T/s. Definite: 0 in compression, T/s from a strain of sp.transverse_ramp on, and T/s faded in by a
 // smoothstep in between: never negative, so -K stays semi-definite, and C1 in s (a plain cut at the rest
 // length puts a kink into the step map at every spring that crosses it, and the optimiser stalls on
-// them). It adds no stiffness the force does not have, so it damps nothing.
+// them). It adds no stiffness the force does not have; what it leaves out acts explicitly, and a narrower
+// ramp puts more into the implicit solve, which backward Euler damps (ClothSpec::transverse_ramp).
 void transverse_stiffness(const BucklingSpring& sp, double s, double T, double dT, bool definite, double& t,
                           double& dt) {
   t = T / s;
