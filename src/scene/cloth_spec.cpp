@@ -141,6 +141,7 @@ ClothSpec parse_cloth_spec(Block& b) {
   s.max_halvings = b.integer("max_halvings", s.max_halvings, 0, 16);
   s.contact_ramp = b.number("contact_ramp", s.contact_ramp, 0.0, 1.0);
   s.transverse_ramp = b.number("transverse_ramp", s.transverse_ramp, 1e-4, 1.0);
+  s.theta = b.number("theta", s.theta, 0.5, 1.0);
   for (Block& c : b.array("colliders")) s.colliders.push_back(parse_collider(std::move(c)));
   b.finish();
   return s;

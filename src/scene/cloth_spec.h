@@ -95,6 +95,11 @@ struct ClothSpec {
   // Narrower: more of it implicit, so light particles on taut springs stop chattering (fewer PCG
   // iterations and split steps) but the sheet's motion is damped more (README, Cloth solver speed).
   double transverse_ramp = 0.05;
+  // The step's implicitness: forces act at x + theta (x1 - x), v + theta (v1 - v) (the one-leg theta
+  // method, linearised as backward Euler with step theta h). 1: backward Euler, which damps motion that
+  // takes few steps a period; 0.5: implicit midpoint, no numerical damping; between: less damping than 1.
+  // Below 1 the transverse stiffness needs a narrow transverse_ramp, or its explicit part grows.
+  double theta = 1.0;
   std::vector<ColliderSpec> colliders;
 
   int particles() const { return nx * ny; }

@@ -58,6 +58,7 @@ std::vector<Case> cases() {
       {"stage_controls_last", replace(replace(g, R"("kind": "per_frame")", R"("kind": "initial_velocity")"), R"("max_evaluations": 5)", R"("schedule": [{"substeps": 1, "controls": {"kind": "initial_rigid_velocity"}}])"), "/optimizer/schedule/0/controls: the last stage uses the scene's controls (no \"controls\")"},
       {"stage_controls_kind", replace(replace(g, R"("kind": "per_frame")", R"("kind": "initial_velocity")"), R"("max_evaluations": 5)", R"("schedule": [{"substeps": 1, "controls": {"kind": "per_step"}}, {"substeps": 1}])"), "/optimizer/schedule/0/controls/kind: expected one of \"initial_velocity\", \"initial_rigid_velocity\", got \"per_step\""},
       {"transverse_ramp_zero", replace(g, R"("cloth": {"nx": 3, "ny": 3})", R"("cloth": {"nx": 3, "ny": 3, "transverse_ramp": 0})"), "/cloth/transverse_ramp: expected a number in [0.0001, 1], got 0"},
+      {"theta_below_half", replace(g, R"("cloth": {"nx": 3, "ny": 3})", R"("cloth": {"nx": 3, "ny": 3, "theta": 0.4})"), "/cloth/theta: expected a number in [0.5, 1], got 0.4"},
       {"seed_type", replace(g, R"("time")", R"("seed": "one", "time")"), "/seed: expected an integer, got string"},
   };
 }

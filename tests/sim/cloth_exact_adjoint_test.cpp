@@ -61,6 +61,23 @@ const Case kCases[] = {
        "colliders": [{"type": "sphere", "center": [0, 0, 0], "radius": 0.1, "thickness": 0.03, "stiffness": 3000}])",
      R"({"kind": "per_step", "alpha": 1e-4})",
      R"([{"type": "center_of_mass", "frame": 3, "weight": 100, "target": [0.05, 0.2, 0]}])", 1e-4},
+    // The theta step (cloth.theta) below backward Euler's 1, with the narrow transverse ramp it needs: pins,
+    // contact, compression and both control integrations.
+    {"theta_sphere_pinned", R"("origin": [-0.25, 0.12, -0.25], "v_axis": [0, 0, 1], "pins": "top_corners",
+       "theta": 0.6, "transverse_ramp": 0.002,
+       "colliders": [{"type": "sphere", "center": [0, 0, 0], "radius": 0.1, "thickness": 0.03, "stiffness": 3000}])",
+     R"({"kind": "per_step", "alpha": 1e-4})",
+     R"([{"type": "center_of_mass", "frame": 3, "weight": 100, "target": [0.05, 0.2, 0]}])", 1e-4},
+    {"theta_ground_falling", R"("origin": [-0.25, 0.02, -0.25], "v_axis": [0, 0.2, 0.98], "velocity": [0.3, -0.6, 0],
+       "theta": 0.5, "transverse_ramp": 0.002,
+       "colliders": [{"type": "ground", "center": [0, 0, 0], "axis": [0, 1, 0], "thickness": 0.03, "stiffness": 3000}])",
+     R"({"kind": "per_frame", "alpha": 1e-4})",
+     R"([{"type": "center_of_mass", "frame": 3, "weight": 100, "target": [0.1, 0.1, 0]}])", 1e-4},
+    {"theta_explicit_compressed_arch", R"("origin": [-0.25, 0, -0.25], "v_axis": [0, 0, 1], "gravity": [0, 0, 0],
+       "theta": 0.55, "transverse_ramp": 0.002, "control_integration": "explicit")",
+     R"({"kind": "per_frame", "alpha": 1e-5})",
+     R"([{"type": "arch", "frame": 3, "weight": 100, "axis_point": [0, -0.2, 0], "axis": [0, 0, 1], "radius": 0.3}])",
+     1e-4},
 };
 
 Scene scene_of(const Case& c, int substeps) {

@@ -126,5 +126,16 @@ TEST(ClothGradient, ExactAdjointMatchesFiniteDifferencesWithANarrowTransverseRam
   }
 }
 
+// The theta step (cloth.theta) below backward Euler's 1: its solve runs with step theta h and its velocity
+// keeps part of the last one, which the adjoint's right-hand side and velocity terms follow.
+TEST(ClothGradient, ExactAdjointMatchesFiniteDifferencesWithTheThetaStep) {
+  for (double theta : {0.5, 0.6})
+    for (double h : {1.0 / 30, 1.0 / 60}) {
+      const Study s = study(h, AdjointKind::kExact, R"(, "transverse_ramp": 0.002, "theta": )" + std::to_string(theta));
+      std::printf("  h = 1/%.0f, theta %.1f: exact rel. error %.3e\n", 1 / h, theta, s.relative_error);
+      EXPECT_LT(s.relative_error, 1e-6) << "h = " << h << " theta " << theta;
+    }
+}
+
 }  // namespace
 }  // namespace kf

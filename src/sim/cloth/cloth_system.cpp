@@ -230,12 +230,15 @@ void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs, bool 
 bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u,
                               VecX& x_next, VecX& v_next) {
   const double h = std::ldexp(h_, -depth), t1 = t0 + std::ldexp(1.0, -depth);
+  // The theta step is backward Euler's with step theta h: its solve gives w = theta (v1 - v) and
+  // x1 = x + h (v + w) (see ClothSpec::theta).
+  const double theta = spec_.theta, hs = theta * h;
   const bool kick = spec_.explicit_controls();  // u added after the solve, not in b
-  assemble(n, x, v, h);
+  assemble(n, x, v, hs);
   tbb::parallel_for(tbb::blocked_range<int>(0, p_, kParticleGrain), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i) {
       const Vec3 ui = kick ? Vec3::Zero() : Vec3(seg(u, i));
-      seg(rhs_, i) = h * (seg(force_, i) + h * stiffness_times_velocity(i, v) + ui);
+      seg(rhs_, i) = hs * (seg(force_, i) + hs * stiffness_times_velocity(i, v) + ui);
     }
   }, tbb::static_partitioner());
   // Substeps start cold, so a split step depends on its inputs only.
@@ -258,9 +261,11 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
   // dv_ stays the solve's part: the record's dv, which the adjoint's A(x) dv terms need.
   tbb::parallel_for(tbb::blocked_range<int>(0, p_, kParticleGrain), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i) {
-      seg(v_next, i) = seg(v, i) + seg(dv_, i);
-      if (kick && free_[i]) seg(v_next, i) += (h / mass_[i]) * seg(u, i);
-      seg(x_next, i) = seg(x, i) + h * seg(v_next, i);
+      Vec3 moved = seg(v, i) + seg(dv_, i);  // the velocity x moves with
+      const Vec3 push = kick && free_[i] ? Vec3((h / mass_[i]) * seg(u, i)) : Vec3::Zero();
+      moved += push;
+      seg(v_next, i) = theta == 1 ? moved : Vec3(seg(v, i) + seg(dv_, i) / theta + push);
+      seg(x_next, i) = seg(x, i) + h * moved;
     }
   }, tbb::static_partitioner());
   return res.converged && x_next.allFinite() && v_next.allFinite();
@@ -357,8 +362,8 @@ bool ClothSystem::checked_step(int n, int depth, double t0, const VecX& x, const
     // work in one step): the check measures the solve's own end state.
     const bool kick = spec_.explicit_controls();
     if (kick && solved) {
-      solved_v_ = v + dv_;
-      solved_x_ = x + std::ldexp(h_, -depth) * solved_v_;
+      solved_v_ = v + dv_ / spec_.theta;
+      solved_x_ = x + std::ldexp(h_, -depth) * (v + dv_);
     }
     const VecX& xc = kick ? solved_x_ : x_next;
     const VecX& vc = kick ? solved_v_ : v_next;
@@ -450,8 +455,11 @@ void ClothSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX&,
 void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v, const VecX& dv, bool warm_ok,
                                   const VecX& xhat1, const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) {
   const bool exact = adjoint_ == AdjointKind::kExact;
-  assemble(n, x, v, h, /*forces=*/false);
-  rhs_ = vhat1 + h * xhat1;
+  // The forward solve ran with step hs = theta h and gave dv = theta (v1 - v), x1 = x + h (v + dv).
+  const double theta = spec_.theta, hs = theta * h;
+  assemble(n, x, v, hs, /*forces=*/false);
+  if (theta == 1) rhs_ = vhat1 + h * xhat1;
+  else rhs_ = vhat1 / theta + h * xhat1;
   // w is zero on pinned particles (and so is every guess).
   const bool warm = warm_ok && adjoint_start_.guess(n, w_);
   const PcgResult res = solve(rhs_, w_, warm);
@@ -474,7 +482,7 @@ void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v,
       Vec3 t, dK;
       // spring_state_ is this substep's: assemble() above ran at the same positions.
       spring_adjoint_products(s, spring_state_[k], derivative, dw, seg(c_, s.b) - seg(c_, s.a), t, dK);
-      if (derivative) t += h * dK;
+      if (derivative) t += hs * dK;
       if (k < damped_)
         t += damping_adjoint_products(s, spec_.damping, spring_state_[k], v, dw, derivative,
                                       seg(dv, s.b) - seg(dv, s.a));
@@ -489,29 +497,32 @@ void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v,
       ContactForce c;
       for (const auto& col : colliders_)
         if (col->contact(n, seg(x, i), seg(v, i), /*definite=*/false, c)) kw += c.dfdx.transpose() * seg(w, i);
+      // v1 = v + dv / theta: below 1, v1 keeps (1 - 1 / theta) of v beside what the solve gives.
       if (free_[i]) {
-        seg(xhat, i) = seg(xhat1, i) + h * kw;
+        seg(xhat, i) = seg(xhat1, i) + hs * kw;
         seg(vhat, i) = mass_[i] * seg(w, i);
+        if (theta != 1) seg(vhat, i) += (1 - 1 / theta) * seg(vhat1, i);
       } else {
-        // x_pin enters the free rows through b (h K) and through the prescribed dv (A / h), and (exact)
-        // its own v1 = (track - x_pin) / h.
-        seg(xhat, i) = h * kw + A_.row_times(i, w) / h;
-        if (exact) seg(xhat, i) -= seg(vhat1, i) / h;
+        // x_pin enters the free rows through b (hs K) and through the prescribed dv = (track - x_pin) / h
+        // - v (A / h), and (exact) its own v1 = v + dv / theta.
+        seg(xhat, i) = hs * kw + A_.row_times(i, w) / h;
+        if (exact) seg(xhat, i) -= seg(vhat1, i) / hs;
         seg(vhat, i).setZero();
+        if (exact && theta != 1) seg(vhat, i) = (1 - 1 / theta) * seg(vhat1, i);
       }
     }
   }, tbb::static_partitioner());
   for (const auto& col : colliders_) {
-    col->add_cross_transpose(n, w, h, xhat);
-    if (exact) col->add_definite_stiffness_derivative(n, x, w, c_, h * h, xhat);
+    col->add_cross_transpose(n, w, hs, xhat);
+    if (exact) col->add_definite_stiffness_derivative(n, x, w, c_, hs * hs, xhat);
   }
   if (!spec_.explicit_controls()) {
-    uhat += h * w;
+    uhat += hs * w;
     return;
   }
-  // v1 = v + dv + h u / m on free particles: u's adjoint skips the solve (rhs = vhat1 + h xhat1).
+  // v1 gets h u / m and x1 h^2 u / m on free particles: u's adjoint skips the solve.
   for (int i = 0; i < p_; ++i)
-    if (free_[i]) seg(uhat, i) += (h / mass_[i]) * seg(rhs_, i);
+    if (free_[i]) seg(uhat, i) += (h / mass_[i]) * Vec3(seg(vhat1, i) + h * seg(xhat1, i));
 }
 
 BlockSparse3 ClothSystem::block_matrix(const std::vector<Mat3>& per_spring, const std::vector<Mat3>& diagonal) const {
@@ -537,6 +548,7 @@ std::string ClothSystem::describe() const {
   os << "cloth: " << spec_.nx << "x" << spec_.ny << " particles, " << springs_.size() << " springs, "
      << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, "
      << (direct_solve_ ? std::string("sparse ") + FilteredDirect::backend() : std::string("PCG (") + preconditioner_name(preconditioner_kind(spec_.cg_preconditioner, p_)) + ", tolerance " + tolerance.str() + ")") << ", " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
+  if (spec_.theta != 1) os << ", theta " << spec_.theta << " step";
   return os.str();
 }
 
