@@ -235,36 +235,65 @@ nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::
     }
     bake.write(out / "solver_bake.csv");
     std::cout << "solver_bake.csv\n" << bake.excerpt() << std::endl;
-    // Speed against error for cloth.transverse_ramp, the strain over which a stretched spring's transverse
-    // stiffness fades into the step's matrix (below it, part of that stiffness acts explicitly): the same
-    // whole bakes at each ramp, their frames against a run with 8 times the steps (default ramp, 1e-6).
+    // Speed against error for the step's settings: cloth.transverse_ramp (the strain over which a stretched
+    // spring's transverse stiffness fades into the step's matrix; below it, part of that stiffness acts
+    // explicitly), cloth.theta (the step's implicitness) and the PCG tolerance. The same whole bakes at each
+    // setting, the same settings at both sizes, their frames against a run with 8 times the steps (defaults,
+    // 1e-6). Below theta 1 only narrow ramps: the ramp's explicit part is no longer damped there (at 0.05
+    // the 100 x 100 bake splits nearly every step, at 0.02 from theta 0.7 down half of them). The first row
+    // is the default.
+    struct Setting {
+      double theta, ramp, tolerance;
+    };
+    std::vector<Setting> settings;
+    for (double ramp : {0.05, 0.035, 0.02, 0.01, 0.005}) settings.push_back({1.0, ramp, 1e-4});
+    for (double tol : {1e-3, 3e-3})
+      for (double ramp : {0.05, 0.02, 0.005}) settings.push_back({1.0, ramp, tol});
+    for (double tol : {1e-4, 1e-3, 3e-3})
+      for (double ramp : {0.02, 0.005}) settings.push_back({0.8, ramp, tol});
+    for (double theta : {0.7, 0.6, 0.55})
+      for (double tol : {1e-4, 1e-3, 3e-3}) settings.push_back({theta, 0.005, tol});
+    CsvTable steps({"n", "theta", "transverse_ramp", "tolerance", "forward_s", "ms_per_step", "over_default",
+                    "split_steps", "pcg_iterations_per_step", "frame_rms_mm", "worst_frame_mm"});
     CsvTable ramps({"n", "transverse_ramp", "forward_s", "ms_per_step", "over_default", "split_steps",
                     "pcg_iterations_per_step", "frame_rms_mm", "worst_frame_mm"});
-    {
-      const std::vector<double> widths = {0.05, 0.035, 0.02, 0.01, 0.005};  // the default first
-      for (int n : {o.blender_n, 2 * o.blender_n}) {
-        std::cerr << "bench solver: transverse ramp, n = " << n << ", reference" << std::endl;
-        Rollout fine;
-        const bool fine_ok = forward_seconds(solver_scene(n, "auto-1e-6", 120, 80), 1, &fine) > 0;
-        std::vector<double> best(widths.size(), 1e300);
-        std::vector<Rollout> runs(widths.size());
-        std::vector<std::vector<std::pair<std::string, double>>> stats(widths.size());
-        for (int r = 0; r < o.repeats; ++r)
-          for (size_t k = 0; k < widths.size(); ++k) {
-            std::cerr << "bench solver: transverse ramp, n = " << n << ", " << widths[k] << std::endl;
-            const std::string keys = ", \"transverse_ramp\": " + fmt(widths[k]);
-            const double s = forward_seconds(solver_scene(n, "auto-1e-4", 120, 10, keys), 1, &runs[k], &stats[k]);
-            best[k] = s < 0 || best[k] < 0 ? -1 : std::min(best[k], s);
-          }
-        for (size_t k = 0; k < widths.size(); ++k) {
-          const bool ok = best[k] > 0 && best[0] > 0 && fine_ok;
-          const auto [rms, worst] = ok ? frames_distance_mm(runs[k], 10, fine, 80, 120) : std::pair<double, double>{0, 0};
-          ramps.add({std::to_string(n), fmt(widths[k]), ok ? fmt(best[k]) : "nan", ok ? fmt(1e3 * best[k] / 1200) : "nan",
-                     ok ? fmt(best[k] / best[0]) : "nan", fmt(stat(stats[k], "split_steps")),
-                     fmt(stat(stats[k], "pcg_iterations_per_step")), ok ? fmt(rms) : "nan", ok ? fmt(worst) : "nan"});
+    for (int n : {o.blender_n, 2 * o.blender_n}) {
+      std::cerr << "bench solver: step settings, n = " << n << ", reference" << std::endl;
+      Rollout fine;
+      const bool fine_ok = forward_seconds(solver_scene(n, "auto-1e-6", 120, 80), 1, &fine) > 0;
+      std::vector<double> best(settings.size(), 1e300);
+      std::vector<Rollout> runs(settings.size());
+      std::vector<std::vector<std::pair<std::string, double>>> stats(settings.size());
+      for (int r = 0; r < o.repeats; ++r)
+        for (size_t k = 0; k < settings.size(); ++k) {
+          const Setting& st = settings[k];
+          std::cerr << "bench solver: step settings, n = " << n << ", theta " << st.theta << ", ramp " << st.ramp
+                    << ", tolerance " << st.tolerance << std::endl;
+          const std::string keys = ", \"transverse_ramp\": " + fmt(st.ramp) + ", \"theta\": " + fmt(st.theta);
+          const double sec = forward_seconds(solver_scene(n, "auto-" + fmt(st.tolerance), 120, 10, keys), 1,
+                                             &runs[k], &stats[k]);
+          best[k] = sec < 0 || best[k] < 0 ? -1 : std::min(best[k], sec);
+        }
+      for (size_t k = 0; k < settings.size(); ++k) {
+        const Setting& st = settings[k];
+        const bool ok = best[k] > 0 && best[0] > 0 && fine_ok;
+        const auto [rms, worst] = ok ? frames_distance_mm(runs[k], 10, fine, 80, 120) : std::pair<double, double>{0, 0};
+        const std::vector<std::string> measured = {
+            ok ? fmt(best[k]) : "nan", ok ? fmt(1e3 * best[k] / 1200) : "nan", ok ? fmt(best[k] / best[0]) : "nan",
+            fmt(stat(stats[k], "split_steps")), fmt(stat(stats[k], "pcg_iterations_per_step")),
+            ok ? fmt(rms) : "nan", ok ? fmt(worst) : "nan"};
+        std::vector<std::string> row = {std::to_string(n), fmt(st.theta), fmt(st.ramp), fmt(st.tolerance)};
+        row.insert(row.end(), measured.begin(), measured.end());
+        steps.add(row);
+        if (st.theta == 1 && st.tolerance == 1e-4) {  // the ramp alone, at the default tolerance
+          std::vector<std::string> ramp_row = {std::to_string(n), fmt(st.ramp)};
+          ramp_row.insert(ramp_row.end(), measured.begin(), measured.end());
+          ramps.add(ramp_row);
         }
       }
     }
+    steps.write(out / "solver_step_settings.csv");
+    std::cout << "solver_step_settings.csv\n" << steps.excerpt() << std::endl;
     ramps.write(out / "solver_transverse_ramp.csv");
     std::cout << "solver_transverse_ramp.csv\n" << ramps.excerpt() << std::endl;
     // One gradient against one forward over the whole 1,200-step anchor run (the sweep below measures 40
