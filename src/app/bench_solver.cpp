@@ -257,41 +257,50 @@ nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::
                     "split_steps", "pcg_iterations_per_step", "frame_rms_mm", "worst_frame_mm"});
     CsvTable ramps({"n", "transverse_ramp", "forward_s", "ms_per_step", "over_default", "split_steps",
                     "pcg_iterations_per_step", "frame_rms_mm", "worst_frame_mm"});
-    for (int n : {o.blender_n, 2 * o.blender_n}) {
-      std::cerr << "bench solver: step settings, n = " << n << ", reference" << std::endl;
-      Rollout fine;
-      const bool fine_ok = forward_seconds(solver_scene(n, "auto-1e-6", 120, 80), 1, &fine) > 0;
-      std::vector<double> best(settings.size(), 1e300);
-      std::vector<Rollout> runs(settings.size());
-      std::vector<std::vector<std::pair<std::string, double>>> stats(settings.size());
-      for (int r = 0; r < o.repeats; ++r)
-        for (size_t k = 0; k < settings.size(); ++k) {
+    // Each repeat runs every setting at both sizes, so drift in the shared machine's speed reaches both alike
+    // (run size after size, one such table had the 50 x 50 bakes a third slower than minutes later).
+    const std::vector<int> sizes = {o.blender_n, 2 * o.blender_n};
+    const size_t ns = sizes.size(), nk = settings.size();
+    std::vector<Rollout> fine(ns);
+    std::vector<char> fine_ok(ns);
+    for (size_t m = 0; m < ns; ++m) {
+      std::cerr << "bench solver: step settings, n = " << sizes[m] << ", reference" << std::endl;
+      fine_ok[m] = forward_seconds(solver_scene(sizes[m], "auto-1e-6", 120, 80), 1, &fine[m]) > 0;
+    }
+    std::vector<double> best(ns * nk, 1e300);
+    std::vector<Rollout> runs(ns * nk);
+    std::vector<std::vector<std::pair<std::string, double>>> stats(ns * nk);
+    for (int r = 0; r < o.repeats; ++r)
+      for (size_t m = 0; m < ns; ++m)
+        for (size_t k = 0; k < nk; ++k) {
           const Setting& st = settings[k];
-          std::cerr << "bench solver: step settings, n = " << n << ", theta " << st.theta << ", ramp " << st.ramp
-                    << ", tolerance " << st.tolerance << std::endl;
+          std::cerr << "bench solver: step settings, n = " << sizes[m] << ", theta " << st.theta << ", ramp "
+                    << st.ramp << ", tolerance " << st.tolerance << std::endl;
           const std::string keys = ", \"transverse_ramp\": " + fmt(st.ramp) + ", \"theta\": " + fmt(st.theta);
-          const double sec = forward_seconds(solver_scene(n, "auto-" + fmt(st.tolerance), 120, 10, keys), 1,
-                                             &runs[k], &stats[k]);
-          best[k] = sec < 0 || best[k] < 0 ? -1 : std::min(best[k], sec);
+          const size_t at = m * nk + k;
+          const double sec = forward_seconds(solver_scene(sizes[m], "auto-" + fmt(st.tolerance), 120, 10, keys), 1,
+                                             &runs[at], &stats[at]);
+          best[at] = sec < 0 || best[at] < 0 ? -1 : std::min(best[at], sec);
         }
-      for (size_t k = 0; k < settings.size(); ++k) {
+    for (size_t m = 0; m < ns; ++m)
+      for (size_t k = 0; k < nk; ++k) {
         const Setting& st = settings[k];
-        const bool ok = best[k] > 0 && best[0] > 0 && fine_ok;
-        const auto [rms, worst] = ok ? frames_distance_mm(runs[k], 10, fine, 80, 120) : std::pair<double, double>{0, 0};
+        const size_t at = m * nk + k, first = m * nk;
+        const bool ok = best[at] > 0 && best[first] > 0 && fine_ok[m];
+        const auto [rms, worst] = ok ? frames_distance_mm(runs[at], 10, fine[m], 80, 120) : std::pair<double, double>{0, 0};
         const std::vector<std::string> measured = {
-            ok ? fmt(best[k]) : "nan", ok ? fmt(1e3 * best[k] / 1200) : "nan", ok ? fmt(best[k] / best[0]) : "nan",
-            fmt(stat(stats[k], "split_steps")), fmt(stat(stats[k], "pcg_iterations_per_step")),
+            ok ? fmt(best[at]) : "nan", ok ? fmt(1e3 * best[at] / 1200) : "nan", ok ? fmt(best[at] / best[first]) : "nan",
+            fmt(stat(stats[at], "split_steps")), fmt(stat(stats[at], "pcg_iterations_per_step")),
             ok ? fmt(rms) : "nan", ok ? fmt(worst) : "nan"};
-        std::vector<std::string> row = {std::to_string(n), fmt(st.theta), fmt(st.ramp), fmt(st.tolerance)};
+        std::vector<std::string> row = {std::to_string(sizes[m]), fmt(st.theta), fmt(st.ramp), fmt(st.tolerance)};
         row.insert(row.end(), measured.begin(), measured.end());
         steps.add(row);
         if (st.theta == 1 && st.tolerance == 1e-4) {  // the ramp alone, at the default tolerance
-          std::vector<std::string> ramp_row = {std::to_string(n), fmt(st.ramp)};
+          std::vector<std::string> ramp_row = {std::to_string(sizes[m]), fmt(st.ramp)};
           ramp_row.insert(ramp_row.end(), measured.begin(), measured.end());
           ramps.add(ramp_row);
         }
       }
-    }
     steps.write(out / "solver_step_settings.csv");
     std::cout << "solver_step_settings.csv\n" << steps.excerpt() << std::endl;
     ramps.write(out / "solver_transverse_ramp.csv");
