@@ -48,9 +48,10 @@ void add_gradcheck_command(CLI::App& app) {
   sub->add_option("--substeps", o->substeps, "override the integrator steps per frame")->check(CLI::Range(1, 100000));
   sub->add_option("--dt", o->dt, "override the time step in seconds (must divide the frame time)")
       ->check(CLI::Range(1e-7, 1.0));
-  sub->add_option("--perturb", o->perturb, "scale of the random controls the check is made at")
-      ->check(CLI::Range(0.0, 1e6));
-  sub->add_option("--seed", o->seed, "seed for the sample and the controls");
+  sub->add_option("--perturb", o->perturb, "scale of the random controls the check is made at (0: the scene's initial guess)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  sub->add_option("--seed", o->seed, "seed for the sample and the controls")->capture_default_str();
   sub->add_option("--adjoint", o->adjoint, "cloth adjoint: exact (the step's own Jacobian) or swap (the paper's "
                                            "integrator swap); default: the scene's optimizer.adjoint")
       ->check(CLI::IsMember({"exact", "swap"}));
