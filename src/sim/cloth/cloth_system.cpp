@@ -232,7 +232,8 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
   const double h = std::ldexp(h_, -depth), t1 = t0 + std::ldexp(1.0, -depth);
   // The theta step is backward Euler's with step theta h: its solve gives w = theta (v1 - v) and
   // x1 = x + h (v + w) (see ClothSpec::theta).
-  const double theta = spec_.theta, hs = theta * h;
+  // 1 / theta is exactly 1 at theta 1, so backward Euler keeps its bits.
+  const double theta = spec_.theta, hs = theta * h, inv_theta = 1 / theta;
   const bool kick = spec_.explicit_controls();  // u added after the solve, not in b
   assemble(n, x, v, hs);
   tbb::parallel_for(tbb::blocked_range<int>(0, p_, kParticleGrain), [&](const tbb::blocked_range<int>& r) {
@@ -261,11 +262,9 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
   // dv_ stays the solve's part: the record's dv, which the adjoint's A(x) dv terms need.
   tbb::parallel_for(tbb::blocked_range<int>(0, p_, kParticleGrain), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i) {
-      Vec3 moved = seg(v, i) + seg(dv_, i);  // the velocity x moves with
       const Vec3 push = kick && free_[i] ? Vec3((h / mass_[i]) * seg(u, i)) : Vec3::Zero();
-      moved += push;
-      seg(v_next, i) = theta == 1 ? moved : Vec3(seg(v, i) + seg(dv_, i) / theta + push);
-      seg(x_next, i) = seg(x, i) + h * moved;
+      seg(v_next, i) = seg(v, i) + inv_theta * seg(dv_, i) + push;
+      seg(x_next, i) = seg(x, i) + h * (seg(v, i) + seg(dv_, i) + push);  // moves with v + theta (v1 - v)
     }
   }, tbb::static_partitioner());
   return res.converged && x_next.allFinite() && v_next.allFinite();
@@ -458,8 +457,7 @@ void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v,
   // The forward solve ran with step hs = theta h and gave dv = theta (v1 - v), x1 = x + h (v + dv).
   const double theta = spec_.theta, hs = theta * h;
   assemble(n, x, v, hs, /*forces=*/false);
-  if (theta == 1) rhs_ = vhat1 + h * xhat1;
-  else rhs_ = vhat1 / theta + h * xhat1;
+  rhs_ = (1 / theta) * vhat1 + h * xhat1;  // 1 / theta is exactly 1 at theta 1
   // w is zero on pinned particles (and so is every guess).
   const bool warm = warm_ok && adjoint_start_.guess(n, w_);
   const PcgResult res = solve(rhs_, w_, warm);
