@@ -1,7 +1,7 @@
 // Solver sweep: the cloth step's cost against particles for each linear solver, on 1 and 2 threads,
 // forward and gradient; what a motion needs of the solve (end states against the integrator's own error);
-// the pinned 50 x 50 sheet beside Blender's bake when `blender` is installed, and its whole bake at twice the
-// resolution.
+// the pinned 50 x 50 sheet beside Blender's bake when `blender` is installed, and the whole bake at that size and
+// twice the resolution (beside Blender's bakes of both).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -214,23 +214,28 @@ nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::
     // default tolerance and preconditioner), repeats interleaved: the sweep below compares 40 steps, the
     // start of the swing, which is the cheap part at 100 x 100 (fewer PCG iterations and no split steps).
     // The split steps and iterations say where the larger sheet's extra time goes (the same every repeat).
+    // Blender bakes the same two sheets in the same loop (when it is installed), so its own growth with the
+    // resolution stands beside ours.
     CsvTable bake({"n", "particles", "steps", "forward_s", "ms_per_step", "over_first", "split_steps",
-                   "pcg_iterations_per_step"});
+                   "pcg_iterations_per_step", "blender_s", "blender_over_first", "blender_over_ours"});
     {
       const std::vector<int> sizes = {o.blender_n, 2 * o.blender_n};
-      std::vector<double> best(sizes.size(), 1e300);
+      std::vector<double> best(sizes.size(), 1e300), blender(sizes.size(), b > 0 ? 1e300 : -1);
       std::vector<std::vector<std::pair<std::string, double>>> stats(sizes.size());
       for (int r = 0; r < o.repeats; ++r)
         for (size_t k = 0; k < sizes.size(); ++k) {
           std::cerr << "bench solver: whole bake, n = " << sizes[k] << std::endl;
           const double s = forward_seconds(solver_scene(sizes[k], "auto-1e-4", 120), 1, nullptr, &stats[k]);
           best[k] = s < 0 || best[k] < 0 ? -1 : std::min(best[k], s);
+          if (blender[k] > 0) blender[k] = std::min(blender[k], blender_seconds(o.blender_script, sizes[k], out));
         }
       for (size_t k = 0; k < sizes.size(); ++k) {
-        const bool ok = best[k] > 0 && best[0] > 0;
+        const bool ok = best[k] > 0 && best[0] > 0, bl = blender[k] > 0 && blender[0] > 0;
         bake.add({std::to_string(sizes[k]), std::to_string(sizes[k] * sizes[k]), "1200", ok ? fmt(best[k]) : "nan",
                   ok ? fmt(1e3 * best[k] / 1200) : "nan", ok ? fmt(best[k] / best[0]) : "nan",
-                  fmt(stat(stats[k], "split_steps")), fmt(stat(stats[k], "pcg_iterations_per_step"))});
+                  fmt(stat(stats[k], "split_steps")), fmt(stat(stats[k], "pcg_iterations_per_step")),
+                  bl ? fmt(blender[k]) : "nan", bl ? fmt(blender[k] / blender[0]) : "nan",
+                  bl && ok ? fmt(blender[k] / best[k]) : "nan"});
       }
     }
     bake.write(out / "solver_bake.csv");
