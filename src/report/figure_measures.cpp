@@ -1,4 +1,4 @@
-#include "opt/measures.h"
+#include "report/figure_measures.h"
 
 #include <algorithm>
 #include <cmath>

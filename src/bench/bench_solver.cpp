@@ -13,9 +13,9 @@
 #include <tbb/global_control.h>
 
 #include "adjoint/rollout.h"
-#include "app/bench_point.h"
-#include "app/bench_sweeps.h"
-#include "app/plot.h"
+#include "bench/bench_point.h"
+#include "bench/bench_sweeps.h"
+#include "report/plot.h"
 #include "sim/make_system.h"
 
 namespace kf {

@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <iostream>
 
-#include "app/bench_sweeps.h"
+#include "bench/bench_sweeps.h"
 #include "app/commands.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
