@@ -167,173 +167,192 @@ CsvTable motion_tolerance_table(const std::vector<double>& tolerances) {
   return t;
 }
 
-}  // namespace
+// Blender's bake of the 50 x 50 sheet beside ours at each tolerance: the whole 120-frame x 10-step bake,
+// default threads, both the fastest of the same number of runs. Speed against error: our run at each
+// tolerance, its end positions against a run solved to 1e-12 (RMS and largest distance over the particles,
+// mm). Each repeat runs Blender's bake and then ours at every tolerance, so that drift in the shared machine's
+// speed over the run reaches both sides alike (our bake timed 1.33 s at the end of a full sweep and 1.0 s on
+// its own minutes later, the same binary). Sets `blender_s` (-1: Blender or its script not found).
+CsvTable blender_side_by_side(const SolverSweepOptions& o, const std::filesystem::path& out, double& blender_s) {
+  Rollout reference;
+  forward_seconds(solver_scene(o.blender_n, "pcg-1e-12", 120), 1, &reference);
+  const int tols = int(o.blender_tolerances.size());
+  double b = 1e300;
+  std::vector<double> ours_best(tols, 1e300);
+  std::vector<Rollout> ends(tols);
+  for (int r = 0; r < o.repeats; ++r) {
+    if (b > 0) b = std::min(b, blender_seconds(o.blender_script, o.blender_n, out));
+    for (int t = 0; t < tols; ++t) {
+      std::ostringstream name;
+      name << "pcg-" << o.blender_tolerances[t];
+      const double s = forward_seconds(solver_scene(o.blender_n, name.str(), 120), 1, &ends[t]);
+      ours_best[t] = s < 0 || ours_best[t] < 0 ? -1 : std::min(ours_best[t], s);
+    }
+  }
+  if (b < 0) std::cerr << "bench solver: blender or " << o.blender_script << " not found; no side-by-side\n";
+  CsvTable side({"n", "frames", "steps", "tolerance", "ours_s", "blender_s", "blender_over_ours", "rms_mm", "max_mm"});
+  for (int t = 0; t < tols; ++t) {
+    const double tol = o.blender_tolerances[t], ours = ours_best[t];
+    const bool ok = ours > 0 && !ends[t].x.empty() && ends[t].x.back().size() == reference.x.back().size();
+    const auto [rms, worst] = ok ? end_distance_mm(ends[t].x.back(), reference.x.back()) : std::pair<double, double>{0, 0};
+    side.add({std::to_string(o.blender_n), "120", "1200", fmt(tol), ok ? fmt(ours) : "nan", b > 0 ? fmt(b) : "nan",
+              ok && b > 0 ? fmt(b / ours) : "nan", ok ? fmt(rms) : "nan", ok ? fmt(worst) : "nan"});
+  }
+  blender_s = b;
+  return side;
+}
 
-nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::path& out) {
-  nlohmann::json summary;
+void print_table(const std::string& name, const CsvTable& t) { std::cout << name << "\n" << t.excerpt() << std::endl; }
+
+// The whole bake at 100 x 100 against the 50 x 50 one, the way `keyframe simulate` runs both (its default
+// tolerance and preconditioner), repeats interleaved: the resolution sweep compares 40 steps, the start of the
+// swing, which is the cheap part at 100 x 100 (fewer PCG iterations and no split steps). The split steps and
+// iterations say where the larger sheet's extra time goes (the same every repeat). Blender bakes the same two
+// sheets in the same loop (when it is installed, `blender_s` > 0), so its own growth with the resolution
+// stands beside ours. Writes solver_bake.csv.
+void whole_bake_table(const SolverSweepOptions& o, const std::filesystem::path& out, double blender_s) {
+  CsvTable bake({"n", "particles", "steps", "forward_s", "ms_per_step", "over_first", "split_steps",
+                 "pcg_iterations_per_step", "blender_s", "blender_over_first", "blender_over_ours"});
+  const std::vector<int> sizes = {o.blender_n, 2 * o.blender_n};
+  std::vector<double> best(sizes.size(), 1e300), blender(sizes.size(), blender_s > 0 ? 1e300 : -1);
+  std::vector<std::vector<std::pair<std::string, double>>> stats(sizes.size());
+  for (int r = 0; r < o.repeats; ++r)
+    for (size_t k = 0; k < sizes.size(); ++k) {
+      std::cerr << "bench solver: whole bake, n = " << sizes[k] << std::endl;
+      const double s = forward_seconds(solver_scene(sizes[k], "auto-1e-4", 120), 1, nullptr, &stats[k]);
+      best[k] = s < 0 || best[k] < 0 ? -1 : std::min(best[k], s);
+      if (blender[k] > 0) blender[k] = std::min(blender[k], blender_seconds(o.blender_script, sizes[k], out));
+    }
+  for (size_t k = 0; k < sizes.size(); ++k) {
+    const bool ok = best[k] > 0 && best[0] > 0, bl = blender[k] > 0 && blender[0] > 0;
+    bake.add({std::to_string(sizes[k]), std::to_string(sizes[k] * sizes[k]), "1200", ok ? fmt(best[k]) : "nan",
+              ok ? fmt(1e3 * best[k] / 1200) : "nan", ok ? fmt(best[k] / best[0]) : "nan",
+              fmt(stat(stats[k], "split_steps")), fmt(stat(stats[k], "pcg_iterations_per_step")),
+              bl ? fmt(blender[k]) : "nan", bl ? fmt(blender[k] / blender[0]) : "nan",
+              bl && ok ? fmt(blender[k] / best[k]) : "nan"});
+  }
+  bake.write(out / "solver_bake.csv");
+  print_table("solver_bake.csv", bake);
+}
+
+struct StepSetting {
+  double theta, ramp, tolerance;
+};
+
+// Speed against error for the step's settings: cloth.transverse_ramp (the strain over which a stretched
+// spring's transverse stiffness fades into the step's matrix; below it, part of that stiffness acts
+// explicitly), cloth.theta (the step's implicitness) and the PCG tolerance. Below theta 1 only narrow ramps:
+// the ramp's explicit part is no longer damped there (at 0.05 the 100 x 100 bake splits nearly every step, at
+// 0.02 from theta 0.7 down half of them). The first setting is the default.
+std::vector<StepSetting> step_settings() {
+  std::vector<StepSetting> settings;
+  for (double ramp : {0.05, 0.035, 0.02, 0.01, 0.005}) settings.push_back({1.0, ramp, 1e-4});
+  for (double tol : {1e-3, 3e-3})
+    for (double ramp : {0.05, 0.02, 0.005}) settings.push_back({1.0, ramp, tol});
+  for (double tol : {1e-4, 1e-3, 3e-3})
+    for (double ramp : {0.02, 0.005}) settings.push_back({0.8, ramp, tol});
+  for (double theta : {0.7, 0.6, 0.55})
+    for (double tol : {1e-4, 1e-3, 3e-3}) settings.push_back({theta, 0.005, tol});
+  return settings;
+}
+
+// The whole bakes of every setting at each size (index m * settings + k), fastest of the repeats, and their
+// frames. Each repeat runs every setting at both sizes, so drift in the shared machine's speed reaches both
+// alike (run size after size, one such table had the 50 x 50 bakes a third slower than minutes later).
+struct SettingRuns {
+  std::vector<double> best;
+  std::vector<Rollout> runs;
+  std::vector<std::vector<std::pair<std::string, double>>> stats;
+};
+
+SettingRuns run_step_settings(const SolverSweepOptions& o, const std::vector<int>& sizes,
+                              const std::vector<StepSetting>& settings) {
+  const size_t ns = sizes.size(), nk = settings.size();
+  SettingRuns r{std::vector<double>(ns * nk, 1e300), std::vector<Rollout>(ns * nk), {}};
+  r.stats.resize(ns * nk);
+  for (int rep = 0; rep < o.repeats; ++rep)
+    for (size_t m = 0; m < ns; ++m)
+      for (size_t k = 0; k < nk; ++k) {
+        const StepSetting& st = settings[k];
+        std::cerr << "bench solver: step settings, n = " << sizes[m] << ", theta " << st.theta << ", ramp "
+                  << st.ramp << ", tolerance " << st.tolerance << std::endl;
+        const std::string keys = ", \"transverse_ramp\": " + fmt(st.ramp) + ", \"theta\": " + fmt(st.theta);
+        const size_t at = m * nk + k;
+        const double sec = forward_seconds(solver_scene(sizes[m], "auto-" + fmt(st.tolerance), 120, 10, keys), 1,
+                                           &r.runs[at], &r.stats[at]);
+        r.best[at] = sec < 0 || r.best[at] < 0 ? -1 : std::min(r.best[at], sec);
+      }
+  return r;
+}
+
+// The same whole bakes at each setting, the same settings at both sizes, their frames against a run with 8
+// times the steps (defaults, 1e-6). Writes solver_step_settings.csv and solver_transverse_ramp.csv (the ramp
+// alone, at theta 1 and the default tolerance).
+void step_settings_tables(const SolverSweepOptions& o, const std::filesystem::path& out) {
+  CsvTable steps({"n", "theta", "transverse_ramp", "tolerance", "forward_s", "ms_per_step", "over_default",
+                  "split_steps", "pcg_iterations_per_step", "frame_rms_mm", "worst_frame_mm"});
+  CsvTable ramps({"n", "transverse_ramp", "forward_s", "ms_per_step", "over_default", "split_steps",
+                  "pcg_iterations_per_step", "frame_rms_mm", "worst_frame_mm"});
+  const std::vector<int> sizes = {o.blender_n, 2 * o.blender_n};
+  const std::vector<StepSetting> settings = step_settings();
+  const size_t ns = sizes.size(), nk = settings.size();
+  std::vector<Rollout> fine(ns);
+  std::vector<char> fine_ok(ns);
+  for (size_t m = 0; m < ns; ++m) {
+    std::cerr << "bench solver: step settings, n = " << sizes[m] << ", reference" << std::endl;
+    fine_ok[m] = forward_seconds(solver_scene(sizes[m], "auto-1e-6", 120, 80), 1, &fine[m]) > 0;
+  }
+  const SettingRuns r = run_step_settings(o, sizes, settings);
+  for (size_t m = 0; m < ns; ++m)
+    for (size_t k = 0; k < nk; ++k) {
+      const StepSetting& st = settings[k];
+      const size_t at = m * nk + k, first = m * nk;
+      const bool ok = r.best[at] > 0 && r.best[first] > 0 && fine_ok[m];
+      const auto [rms, worst] = ok ? frames_distance_mm(r.runs[at], 10, fine[m], 80, 120) : std::pair<double, double>{0, 0};
+      const std::vector<std::string> measured = {
+          ok ? fmt(r.best[at]) : "nan", ok ? fmt(1e3 * r.best[at] / 1200) : "nan",
+          ok ? fmt(r.best[at] / r.best[first]) : "nan", fmt(stat(r.stats[at], "split_steps")),
+          fmt(stat(r.stats[at], "pcg_iterations_per_step")), ok ? fmt(rms) : "nan", ok ? fmt(worst) : "nan"};
+      std::vector<std::string> row = {std::to_string(sizes[m]), fmt(st.theta), fmt(st.ramp), fmt(st.tolerance)};
+      row.insert(row.end(), measured.begin(), measured.end());
+      steps.add(row);
+      if (st.theta == 1 && st.tolerance == 1e-4) {
+        std::vector<std::string> ramp_row = {std::to_string(sizes[m]), fmt(st.ramp)};
+        ramp_row.insert(ramp_row.end(), measured.begin(), measured.end());
+        ramps.add(ramp_row);
+      }
+    }
+  steps.write(out / "solver_step_settings.csv");
+  print_table("solver_step_settings.csv", steps);
+  ramps.write(out / "solver_transverse_ramp.csv");
+  print_table("solver_transverse_ramp.csv", ramps);
+}
+
+// One gradient against one forward over the whole 1,200-step anchor run (the resolution sweep measures 40
+// steps, where the warm starts have less history to work with). Writes solver_anchor_gradient.csv.
+void anchor_gradient_table(const SolverSweepOptions& o, const BenchPointOptions& po, const std::filesystem::path& out) {
+  CsvTable anchor({"n", "frames", "steps", "threads", "forward_s", "gradient_s", "gradient_over_forward"});
+  for (int t : o.threads) {
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, t);
+    const BenchPoint p = measure_point(solver_scene(o.blender_n, "pcg", 120), po);
+    anchor.add({std::to_string(o.blender_n), "120", "1200", std::to_string(t), p.diverged ? "nan" : fmt(p.forward_s),
+                p.diverged ? "nan" : fmt(p.gradient_s), p.diverged ? "nan" : fmt(p.gradient_s / p.forward_s)});
+  }
+  anchor.write(out / "solver_anchor_gradient.csv");
+  print_table("solver_anchor_gradient.csv", anchor);
+}
+
+// The step's cost against particles, per solver and thread count, over the same frames at every size (a
+// step's cost changes along the motion: the first steps, a flat sheet at rest, are the cheapest).
+CsvTable resolution_sweep(const SolverSweepOptions& o, const BenchPointOptions& po) {
   std::vector<std::string> cols = {"n", "particles"};
   for (const auto& s : o.solvers)
     for (int t : o.threads)
       for (const char* what : {"forward_ms", "gradient_ms", "gradient_over_forward"})
         cols.push_back(s + "_t" + std::to_string(t) + "_" + what);
   CsvTable table(cols);
-  BenchPointOptions po;
-  po.repeats = o.repeats;
-  // Side by side, before the sweep: the whole 120-frame x 10-step bake of the 50 x 50 sheet, default threads,
-  // both the fastest of the same number of runs. Speed against error: our run at each tolerance, its end
-  // positions against a run solved to 1e-12 (RMS and largest distance over the particles, mm).
-  if (o.blender_n > 0) {
-    // Each repeat runs Blender's bake and then ours at every tolerance, so that drift in the shared machine's
-    // speed over the run reaches both sides alike (our bake timed 1.33 s at the end of a full sweep and
-    // 1.0 s on its own minutes later, the same binary).
-    Rollout reference;
-    forward_seconds(solver_scene(o.blender_n, "pcg-1e-12", 120), 1, &reference);
-    const int tols = int(o.blender_tolerances.size());
-    double b = 1e300;
-    std::vector<double> ours_best(tols, 1e300);
-    std::vector<Rollout> ends(tols);
-    for (int r = 0; r < o.repeats; ++r) {
-      if (b > 0) b = std::min(b, blender_seconds(o.blender_script, o.blender_n, out));
-      for (int t = 0; t < tols; ++t) {
-        std::ostringstream name;
-        name << "pcg-" << o.blender_tolerances[t];
-        const double s = forward_seconds(solver_scene(o.blender_n, name.str(), 120), 1, &ends[t]);
-        ours_best[t] = s < 0 || ours_best[t] < 0 ? -1 : std::min(ours_best[t], s);
-      }
-    }
-    if (b < 0) std::cerr << "bench solver: blender or " << o.blender_script << " not found; no side-by-side\n";
-    CsvTable side({"n", "frames", "steps", "tolerance", "ours_s", "blender_s", "blender_over_ours", "rms_mm", "max_mm"});
-    for (int t = 0; t < tols; ++t) {
-      const double tol = o.blender_tolerances[t], ours = ours_best[t];
-      const bool ok = ours > 0 && !ends[t].x.empty() && ends[t].x.back().size() == reference.x.back().size();
-      const auto [rms, worst] = ok ? end_distance_mm(ends[t].x.back(), reference.x.back()) : std::pair<double, double>{0, 0};
-      side.add({std::to_string(o.blender_n), "120", "1200", fmt(tol), ok ? fmt(ours) : "nan", b > 0 ? fmt(b) : "nan",
-                ok && b > 0 ? fmt(b / ours) : "nan", ok ? fmt(rms) : "nan", ok ? fmt(worst) : "nan"});
-    }
-    // The whole bake at 100 x 100 against the 50 x 50 one, the way `keyframe simulate` runs both (its
-    // default tolerance and preconditioner), repeats interleaved: the sweep below compares 40 steps, the
-    // start of the swing, which is the cheap part at 100 x 100 (fewer PCG iterations and no split steps).
-    // The split steps and iterations say where the larger sheet's extra time goes (the same every repeat).
-    // Blender bakes the same two sheets in the same loop (when it is installed), so its own growth with the
-    // resolution stands beside ours.
-    CsvTable bake({"n", "particles", "steps", "forward_s", "ms_per_step", "over_first", "split_steps",
-                   "pcg_iterations_per_step", "blender_s", "blender_over_first", "blender_over_ours"});
-    {
-      const std::vector<int> sizes = {o.blender_n, 2 * o.blender_n};
-      std::vector<double> best(sizes.size(), 1e300), blender(sizes.size(), b > 0 ? 1e300 : -1);
-      std::vector<std::vector<std::pair<std::string, double>>> stats(sizes.size());
-      for (int r = 0; r < o.repeats; ++r)
-        for (size_t k = 0; k < sizes.size(); ++k) {
-          std::cerr << "bench solver: whole bake, n = " << sizes[k] << std::endl;
-          const double s = forward_seconds(solver_scene(sizes[k], "auto-1e-4", 120), 1, nullptr, &stats[k]);
-          best[k] = s < 0 || best[k] < 0 ? -1 : std::min(best[k], s);
-          if (blender[k] > 0) blender[k] = std::min(blender[k], blender_seconds(o.blender_script, sizes[k], out));
-        }
-      for (size_t k = 0; k < sizes.size(); ++k) {
-        const bool ok = best[k] > 0 && best[0] > 0, bl = blender[k] > 0 && blender[0] > 0;
-        bake.add({std::to_string(sizes[k]), std::to_string(sizes[k] * sizes[k]), "1200", ok ? fmt(best[k]) : "nan",
-                  ok ? fmt(1e3 * best[k] / 1200) : "nan", ok ? fmt(best[k] / best[0]) : "nan",
-                  fmt(stat(stats[k], "split_steps")), fmt(stat(stats[k], "pcg_iterations_per_step")),
-                  bl ? fmt(blender[k]) : "nan", bl ? fmt(blender[k] / blender[0]) : "nan",
-                  bl && ok ? fmt(blender[k] / best[k]) : "nan"});
-      }
-    }
-    bake.write(out / "solver_bake.csv");
-    std::cout << "solver_bake.csv\n" << bake.excerpt() << std::endl;
-    // Speed against error for the step's settings: cloth.transverse_ramp (the strain over which a stretched
-    // spring's transverse stiffness fades into the step's matrix; below it, part of that stiffness acts
-    // explicitly), cloth.theta (the step's implicitness) and the PCG tolerance. The same whole bakes at each
-    // setting, the same settings at both sizes, their frames against a run with 8 times the steps (defaults,
-    // 1e-6). Below theta 1 only narrow ramps: the ramp's explicit part is no longer damped there (at 0.05
-    // the 100 x 100 bake splits nearly every step, at 0.02 from theta 0.7 down half of them). The first row
-    // is the default.
-    struct Setting {
-      double theta, ramp, tolerance;
-    };
-    std::vector<Setting> settings;
-    for (double ramp : {0.05, 0.035, 0.02, 0.01, 0.005}) settings.push_back({1.0, ramp, 1e-4});
-    for (double tol : {1e-3, 3e-3})
-      for (double ramp : {0.05, 0.02, 0.005}) settings.push_back({1.0, ramp, tol});
-    for (double tol : {1e-4, 1e-3, 3e-3})
-      for (double ramp : {0.02, 0.005}) settings.push_back({0.8, ramp, tol});
-    for (double theta : {0.7, 0.6, 0.55})
-      for (double tol : {1e-4, 1e-3, 3e-3}) settings.push_back({theta, 0.005, tol});
-    CsvTable steps({"n", "theta", "transverse_ramp", "tolerance", "forward_s", "ms_per_step", "over_default",
-                    "split_steps", "pcg_iterations_per_step", "frame_rms_mm", "worst_frame_mm"});
-    CsvTable ramps({"n", "transverse_ramp", "forward_s", "ms_per_step", "over_default", "split_steps",
-                    "pcg_iterations_per_step", "frame_rms_mm", "worst_frame_mm"});
-    // Each repeat runs every setting at both sizes, so drift in the shared machine's speed reaches both alike
-    // (run size after size, one such table had the 50 x 50 bakes a third slower than minutes later).
-    const std::vector<int> sizes = {o.blender_n, 2 * o.blender_n};
-    const size_t ns = sizes.size(), nk = settings.size();
-    std::vector<Rollout> fine(ns);
-    std::vector<char> fine_ok(ns);
-    for (size_t m = 0; m < ns; ++m) {
-      std::cerr << "bench solver: step settings, n = " << sizes[m] << ", reference" << std::endl;
-      fine_ok[m] = forward_seconds(solver_scene(sizes[m], "auto-1e-6", 120, 80), 1, &fine[m]) > 0;
-    }
-    std::vector<double> best(ns * nk, 1e300);
-    std::vector<Rollout> runs(ns * nk);
-    std::vector<std::vector<std::pair<std::string, double>>> stats(ns * nk);
-    for (int r = 0; r < o.repeats; ++r)
-      for (size_t m = 0; m < ns; ++m)
-        for (size_t k = 0; k < nk; ++k) {
-          const Setting& st = settings[k];
-          std::cerr << "bench solver: step settings, n = " << sizes[m] << ", theta " << st.theta << ", ramp "
-                    << st.ramp << ", tolerance " << st.tolerance << std::endl;
-          const std::string keys = ", \"transverse_ramp\": " + fmt(st.ramp) + ", \"theta\": " + fmt(st.theta);
-          const size_t at = m * nk + k;
-          const double sec = forward_seconds(solver_scene(sizes[m], "auto-" + fmt(st.tolerance), 120, 10, keys), 1,
-                                             &runs[at], &stats[at]);
-          best[at] = sec < 0 || best[at] < 0 ? -1 : std::min(best[at], sec);
-        }
-    for (size_t m = 0; m < ns; ++m)
-      for (size_t k = 0; k < nk; ++k) {
-        const Setting& st = settings[k];
-        const size_t at = m * nk + k, first = m * nk;
-        const bool ok = best[at] > 0 && best[first] > 0 && fine_ok[m];
-        const auto [rms, worst] = ok ? frames_distance_mm(runs[at], 10, fine[m], 80, 120) : std::pair<double, double>{0, 0};
-        const std::vector<std::string> measured = {
-            ok ? fmt(best[at]) : "nan", ok ? fmt(1e3 * best[at] / 1200) : "nan", ok ? fmt(best[at] / best[first]) : "nan",
-            fmt(stat(stats[at], "split_steps")), fmt(stat(stats[at], "pcg_iterations_per_step")),
-            ok ? fmt(rms) : "nan", ok ? fmt(worst) : "nan"};
-        std::vector<std::string> row = {std::to_string(sizes[m]), fmt(st.theta), fmt(st.ramp), fmt(st.tolerance)};
-        row.insert(row.end(), measured.begin(), measured.end());
-        steps.add(row);
-        if (st.theta == 1 && st.tolerance == 1e-4) {  // the ramp alone, at the default tolerance
-          std::vector<std::string> ramp_row = {std::to_string(sizes[m]), fmt(st.ramp)};
-          ramp_row.insert(ramp_row.end(), measured.begin(), measured.end());
-          ramps.add(ramp_row);
-        }
-      }
-    steps.write(out / "solver_step_settings.csv");
-    std::cout << "solver_step_settings.csv\n" << steps.excerpt() << std::endl;
-    ramps.write(out / "solver_transverse_ramp.csv");
-    std::cout << "solver_transverse_ramp.csv\n" << ramps.excerpt() << std::endl;
-    // One gradient against one forward over the whole 1,200-step anchor run (the sweep below measures 40
-    // steps, where the warm starts have less history to work with).
-    CsvTable anchor({"n", "frames", "steps", "threads", "forward_s", "gradient_s", "gradient_over_forward"});
-    for (int t : o.threads) {
-      tbb::global_control threads(tbb::global_control::max_allowed_parallelism, t);
-      const BenchPoint p = measure_point(solver_scene(o.blender_n, "pcg", 120), po);
-      anchor.add({std::to_string(o.blender_n), "120", "1200", std::to_string(t), p.diverged ? "nan" : fmt(p.forward_s),
-                  p.diverged ? "nan" : fmt(p.gradient_s), p.diverged ? "nan" : fmt(p.gradient_s / p.forward_s)});
-    }
-    anchor.write(out / "solver_anchor_gradient.csv");
-    std::cout << "solver_anchor_gradient.csv\n" << anchor.excerpt() << std::endl;
-    const auto side_csv = out / "solver_blender.csv";
-    side.write(side_csv);
-    plot_csv(side_csv, out / "solver_blender.png",
-             "50 x 50 sheet, 1200 steps: Blender's time over ours against our end-state RMS error (mm)",
-             side.col("rms_mm"), {side.col("blender_over_ours")}, false, true);
-    summary["blender"] = side.excerpt();
-    std::cout << "solver_blender.csv\n" << side.excerpt() << std::endl;
-  }
   for (int n : o.resolutions) {
     std::vector<std::string> row = {std::to_string(n), std::to_string(n * n)};
-    // The same frames at every size: a step's cost changes along the motion (the first steps, a flat
-    // sheet at rest, are the cheapest), so sizes are compared over the same motion.
-    const int frames = o.frames;
     for (const auto& s : o.solvers)
       for (int t : o.threads) {
         if (s == "direct" && n > o.direct_max_n) {  // a factor per step: minutes at these sizes
@@ -341,8 +360,8 @@ nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::
           continue;
         }
         tbb::global_control threads(tbb::global_control::max_allowed_parallelism, t);
-        const Scene scene = solver_scene(n, s, frames);
-        std::cerr << "bench solver: n = " << n << ", " << s << ", " << t << " thread(s), " << frames << " frames"
+        const Scene scene = solver_scene(n, s, o.frames);
+        std::cerr << "bench solver: n = " << n << ", " << s << ", " << t << " thread(s), " << o.frames << " frames"
                   << std::endl;
         const BenchPoint p = measure_point(scene, po);
         const double steps = scene.time.steps();
@@ -353,6 +372,11 @@ nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::
       }
     table.add(row);
   }
+  return table;
+}
+
+// solver.csv and its two plots (forward, gradient ms per step against particles).
+void write_resolution_sweep(const SolverSweepOptions& o, const CsvTable& table, const std::filesystem::path& out) {
   const auto csv = out / "solver.csv";
   table.write(csv);
   std::vector<int> fwd, grad;
@@ -365,14 +389,36 @@ nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::
            true, true);
   plot_csv(csv, out / "solver_gradient.png", "cloth: gradient (forward + adjoint) ms per step against particles",
            table.col("particles"), grad, true, true);
-  summary["solver"] = table.excerpt();
-  std::cout << "solver.csv\n" << table.excerpt() << std::endl;
+  print_table("solver.csv", table);
+}
 
+}  // namespace
+
+nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::path& out) {
+  nlohmann::json summary;
+  BenchPointOptions po;
+  po.repeats = o.repeats;
+  if (o.blender_n > 0) {  // Blender first, then the tables built around its sheet
+    double blender_s = -1;
+    const CsvTable side = blender_side_by_side(o, out, blender_s);
+    whole_bake_table(o, out, blender_s);
+    step_settings_tables(o, out);
+    anchor_gradient_table(o, po, out);
+    const auto side_csv = out / "solver_blender.csv";
+    side.write(side_csv);
+    plot_csv(side_csv, out / "solver_blender.png",
+             "50 x 50 sheet, 1200 steps: Blender's time over ours against our end-state RMS error (mm)",
+             side.col("rms_mm"), {side.col("blender_over_ours")}, false, true);
+    summary["blender"] = side.excerpt();
+    print_table("solver_blender.csv", side);
+  }
+  const CsvTable table = resolution_sweep(o, po);
+  write_resolution_sweep(o, table, out);
+  summary["solver"] = table.excerpt();
   const CsvTable motion = motion_tolerance_table(o.motion_tolerances);
   motion.write(out / "solver_motion.csv");
   summary["motion"] = motion.excerpt();
-  std::cout << "solver_motion.csv\n" << motion.excerpt() << std::endl;
-
+  print_table("solver_motion.csv", motion);
   return summary;
 }
 
