@@ -66,7 +66,7 @@ TEST_F(Walkthrough, TheReadmeHasScenesAndCommandsToRun) {
   ASSERT_EQ(w.files.size(), 2u);
   EXPECT_EQ(w.files[0].first, "my-flock.json");
   EXPECT_EQ(w.files[1].first, "my-cloth.json");
-  for (const auto& [name, text] : w.files) EXPECT_NO_THROW((void)nlohmann::json::parse(text)) << name;
+  for (const auto& [name, text] : w.files) EXPECT_TRUE(nlohmann::json::accept(text)) << name;
   EXPECT_GE(w.command_blocks.size(), 3u);
   EXPECT_THROW(parse_walkthrough("some text\n```json\n{}\n```\n"), std::runtime_error);
 }
