@@ -14,9 +14,11 @@
 #include "core/error.h"
 #include "core/progress.h"
 #include "core/trajectory.h"
+#include "core/warnings.h"
 #include "opt/controls_file.h"
 #include "report/figure_measures.h"
 #include "opt/optimizer.h"
+#include "scene/reach_check.h"
 #include "sim/make_system.h"
 
 namespace kf {
@@ -209,6 +211,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   const bool resuming = !opt.resume.empty();
   Scene scene = resuming ? load_run_scene(opt.resume) : load_scene(scene_file);
   if (!opt.adjoint.empty()) scene.optimizer.adjoint = opt.adjoint;
+  for (const std::string& w : unreachable_keyframes(scene)) warn(w);
   const fs::path dir = resuming ? fs::path(opt.resume) : run_dir_for(scene, opt.out);
 
   // The stages of coarse-to-fine continuation; a resumed run continues in the last stage.

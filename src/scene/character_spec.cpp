@@ -67,8 +67,13 @@ RootMotion parse_root_motion(Block& b) {
 
 CapeAnchors parse_cape_anchors(Block& b) {
   CapeAnchors a;
+  a.where = b.file() + ": " + b.json_pointer();
   a.mesh = b.string("mesh", "");
-  a.points = b.points3("points", 2, -100.0, 100.0);
+  if (b.has("points") == b.has("nodes"))
+    b.fail_here("expected exactly one of \"points\" ([[x, y, z], ...] in the mesh file's frame) or \"nodes\" "
+                "([\"name\", ...]; keyframe inspect MESH lists them)");
+  if (b.has("points")) a.points = b.points3("points", 2, -100.0, 100.0);
+  else a.nodes = b.strings("nodes", 2);
   b.finish();
   return a;
 }
@@ -107,6 +112,7 @@ CapeAnchors load_cape_anchors(const std::filesystem::path& file) {
 CharacterSpec parse_character_spec(Block b, Scene& scene) {
   if (!scene.cloth) b.fail_here("expected a \"cloth\" block for the cape (a character needs a cloth)");
   CharacterSpec c;
+  c.where = b.file() + ": " + b.json_pointer();
   const int p = scene.particles();
   c.file = scene.directory / b.string("file");
   c.animation = b.integer("animation", 0, 0, 1000);
@@ -115,6 +121,9 @@ CharacterSpec parse_character_spec(Block b, Scene& scene) {
     for (size_t i = 1; i < c.time_keys.size(); ++i)
       if (!(c.time_keys[i].x() > c.time_keys[i - 1].x()))
         b.fail_rel("/time/" + std::to_string(i), "expected frames in ascending order");
+  } else {
+    // The animation at its own rate from its start; the character holds its last pose after its end.
+    c.time_keys = {{0.0, 0.0}, {double(scene.time.frames), scene.time.frames / scene.time.fps}};
   }
   c.offset = b.vec3("offset", Vec3::Zero());
   if (auto root = b.optional_child("root")) c.root = parse_root_motion(*root);

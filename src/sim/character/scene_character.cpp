@@ -1,6 +1,39 @@
 #include "sim/character/scene_character.h"
 
+#include <cstdio>
+
+#include "core/error.h"
+#include "core/warnings.h"
+
 namespace kf {
+
+Character load_character(const CharacterSpec& spec, int frames) {
+  try {
+    Character c(spec.file, character_options(spec));
+    const double end = animation_time(spec, frames);
+    if (end > c.duration() + 1e-9) {
+      // The frame where the animation's time passes its duration (time keys are piecewise linear).
+      double last = frames;
+      for (int f = 0; f <= frames; ++f)
+        if (animation_time(spec, f) > c.duration() + 1e-9) {
+          last = f;
+          break;
+        }
+      char msg[512];
+      std::snprintf(msg, sizeof msg,
+                    "%s: the animation of %s ends at %.3g s, before the scene's last frame (frame %d at %.3g s): the "
+                    "body holds its last pose from frame %.0f on (\"time\" [[frame, seconds], ...] maps frames to "
+                    "the animation's seconds)",
+                    spec.where.c_str(), spec.file.filename().string().c_str(), c.duration(), frames, end, last);
+      warn(msg);
+    }
+    return c;
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    const bool animation = what.find("animation") != std::string::npos;
+    throw InputError(spec.where + (animation ? "/animation: " : "/file: ") + what);
+  }
+}
 
 CharacterOptions character_options(const CharacterSpec& spec) {
   CharacterOptions o;
