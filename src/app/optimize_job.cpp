@@ -17,6 +17,7 @@
 #include "opt/controls_file.h"
 #include "opt/measures.h"
 #include "opt/optimizer.h"
+#include "opt/windows.h"
 #include "sim/make_system.h"
 
 namespace kf {
@@ -212,8 +213,8 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   const fs::path dir = resuming ? fs::path(opt.resume) : run_dir_for(scene, opt.out);
 
   // The stages of coarse-to-fine continuation; a resumed run continues in the last stage.
-  std::vector<StageSpec> stages = scene.optimizer.schedule;
-  if (stages.empty()) stages.push_back({scene.time.substeps, scene.optimizer.max_evaluations});
+  const StagePlan plan = plan_stages(scene);
+  std::vector<StageSpec> stages = plan.stages;
   if (opt.max_evaluations >= 0)
     for (auto& s : stages) s.max_evaluations = opt.max_evaluations;
   JobResult job;
@@ -230,6 +231,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (!resuming) prepare_run_dir(dir, scene);
 
   EvaluationLog elog(opt.quiet);
+  if (!plan.why.empty() && !resuming) elog.say(plan.why);
   SignalGuard signals;
   for (size_t s = 0; s < stages.size() && !job.interrupted; ++s) {
     time.substeps = stages[s].substeps;
@@ -237,6 +239,8 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     Scene stage_scene = scene;  // a stage may optimise a coarser control parameterisation
     if (stages[s].controls) stage_scene.controls = *stages[s].controls;
     VecX& z = job.z;
+    // The first frame of the previous stage's forces (a resumed run's controls are the scene's).
+    const int z_from_frame = job.problem ? job.problem->controls().first_frame() : scene.controls.from_frame;
     VecX v0_before;  // the initial velocities the previous stage's kind gave, when the kind changes
     if (job.problem && job.problem->controls().kind() != std::string(control_kind_name(stage_scene.controls.kind)))
       job.problem->controls().initial_velocity(z, v0_before);
@@ -245,7 +249,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     if (opt.checkpoint_every >= 0) problem.set_checkpoint_every(opt.checkpoint_every);
     if (z.size() == 0) z = problem.initial_guess();
     else if (v0_before.size()) z = problem.controls().from_initial_velocity(v0_before);
-    else z = problem.controls().remap_from(z, z_time);
+    else z = problem.controls().remap_from(z, z_time, z_from_frame);
     if (z.size() != problem.size())
       throw InputError((dir / "controls.bin").string() + ": holds " + std::to_string(z.size()) +
                        " controls, the scene needs " + std::to_string(problem.size()));
@@ -254,7 +258,9 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     elog.say(std::string(resuming ? "resuming " : "optimising ") + scene.name +
              (stage_id ? " stage " + std::to_string(stage_id) : "") + ": " + job.sys->describe() + ", " +
              std::to_string(time.steps()) + " steps (h = " + std::to_string(time.h()) + " s), " +
-             std::to_string(problem.size()) + " control variables (" + problem.controls().kind() + ")");
+             std::to_string(problem.size()) + " control variables (" + problem.controls().kind() +
+             (problem.controls().first_frame() > 0 ? " from frame " + std::to_string(problem.controls().first_frame()) : "") +
+             ")");
     OptimizerSpec spec = scene.optimizer;
     spec.max_evaluations = stages[s].max_evaluations;
     Progress progress("optimize " + scene.name, spec.max_evaluations);
