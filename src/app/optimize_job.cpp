@@ -263,6 +263,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
              ")");
     OptimizerSpec spec = scene.optimizer;
     spec.max_evaluations = stages[s].max_evaluations;
+    if (spec.first_step < 0) spec.first_step = plan.scaled_first_step ? problem.control_scale() : 0;
     Progress progress("optimize " + scene.name, spec.max_evaluations);
     const OptimizeResult res = run_stage(problem, spec, scene.optimizer.restarts, z, stage_id, time.substeps,
                                          job.seconds, elog, progress);

@@ -104,7 +104,7 @@ OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX&
     // first_step RMS per variable, and only when the gradient is steeper than that.
     double f = 0;
     try {
-      const double rms = spec.first_step < 0 ? problem.control_scale() : spec.first_step;
+      const double rms = spec.first_step > 0 ? spec.first_step : 0;  // automatic (< 0) is resolved by the caller
       if (rms > 0) {
         d.z = z0;
         d.first_phi = d.evaluate(&d.g);

@@ -89,6 +89,7 @@ StagePlan plan_stages(const Scene& scene) {
     plan.stages = {{scene.time.substeps, rigid_budget, rigid},
                    {scene.time.substeps, o.max_evaluations - rigid_budget, std::nullopt}};
     plan.why = "stages: a rigid throw (6 variables), then one initial velocity per particle from it";
+    plan.scaled_first_step = true;
     return plan;
   }
   if (c.kind != ControlKind::kPerStep && c.kind != ControlKind::kPerFrame) return plan;
@@ -103,6 +104,7 @@ StagePlan plan_stages(const Scene& scene) {
      << c.from_frame;
   if (plan.growth > o.window_growth) {
     plan.stages = window_stages(scene);
+    plan.scaled_first_step = true;
     os << " (above optimizer.window_growth " << o.window_growth << "): windows from frames "
        << describe(plan.stages, c.from_frame) << " to frame " << last;
   } else {

@@ -22,6 +22,9 @@ namespace kf {
 struct StagePlan {
   std::vector<StageSpec> stages;  // at least one; the last optimises the scene's own controls
   double growth = 0;              // the force gradient's growth at the start (0: not measured)
+  // The strategy staged the run (windows, or a rigid throw first): an automatic optimizer.first_step is
+  // then the problem's control_scale(); elsewhere it is off, and a run is as it was without strategies.
+  bool scaled_first_step = false;
   std::string why;                // one line: the plan and what chose it
 };
 

@@ -92,6 +92,7 @@ TEST(Strategy, ClothForcesGrowWindowsBackwardsFromTheLastKeyframe) {
   }
   EXPECT_EQ(budget, 300);
   EXPECT_FALSE(plan.stages.back().controls);  // the last stage optimises the scene's own controls
+  EXPECT_TRUE(plan.scaled_first_step);
   EXPECT_NE(plan.why.find("windows from frames 23, 18, 8, 0 to frame 28"), std::string::npos) << plan.why;
   const Scene late = strategy_scene(kCloth, R"({"kind": "per_step", "from_frame": 20})",
                                     R"({"window_frames": 3, "window_growth": 1})");
@@ -101,6 +102,7 @@ TEST(Strategy, ClothForcesGrowWindowsBackwardsFromTheLastKeyframe) {
   const StagePlan one = plan_stages(tame);
   EXPECT_EQ(one.stages.size(), 1u);
   EXPECT_EQ(one.growth, plan.growth);
+  EXPECT_FALSE(one.scaled_first_step);  // a run the strategy leaves alone runs as it did without it
 }
 
 // The growth is read from the gradient's frames: a keyframe's own frame's forces against earlier ones.
@@ -120,7 +122,9 @@ TEST(Strategy, GradientGrowthComparesFramesOfTheForceGradient) {
 
 TEST(Strategy, InitialVelocitiesStartFromARigidThrow) {
   const Scene scene = strategy_scene(kCloth, R"({"kind": "initial_velocity", "alpha": 0.5})", R"({"max_evaluations": 90})");
-  const auto stages = plan_stages(scene).stages;
+  const StagePlan plan = plan_stages(scene);
+  EXPECT_TRUE(plan.scaled_first_step);
+  const auto& stages = plan.stages;
   ASSERT_EQ(stages.size(), 2u);
   ASSERT_TRUE(stages[0].controls);
   EXPECT_EQ(stages[0].controls->kind, ControlKind::kInitialRigidVelocity);
