@@ -171,6 +171,7 @@ RunFacts run_facts(const std::string& status, const std::vector<HistoryRow>& his
   f.budget = status.find("limit reached") != std::string::npos;
   if (history.empty()) return f;
   f.objective_start = history.front().rec.phi;
+  f.evaluations = int(history.size());
   double best = INFINITY, best_earlier = INFINITY;
   const size_t earlier = history.size() - std::max<size_t>(1, history.size() / 10);
   for (size_t i = 0; i < history.size(); ++i) {

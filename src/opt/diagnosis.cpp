@@ -13,6 +13,9 @@ namespace kf {
 
 namespace {
 
+// A budget this small says nothing about whether more evaluations would reach the keyframes.
+constexpr int kFewEvaluations = 50;
+
 std::string format(const char* fmt, double a, double b = 0) {
   char buf[1024];
   std::snprintf(buf, sizeof buf, fmt, a, b);
@@ -209,20 +212,27 @@ Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensit
     if (facts.max_objective > 1e6 * std::max(facts.objective_start, 1e-300))
       cause += format("; trial steps reached an objective of %.2g from %.2g", facts.max_objective,
                       facts.objective_start);
-  } else if (facts.budget && facts.recent_improvement < 0.9) {
-    cause = format("cause: it was still improving when it stopped at its budget (the objective fell %.2gx over "
-                   "the last tenth of the evaluations); change: raise optimizer.max_evaluations",
-                   1 / std::max(facts.recent_improvement, 1e-300));
+  } else if (facts.budget && (facts.recent_improvement < 0.9 || facts.evaluations < kFewEvaluations)) {
+    cause = format("cause: its budget ended it after %.0f evaluations (the objective still fell %.2gx over the "
+                   "last tenth of them); change: raise optimizer.max_evaluations",
+                   facts.evaluations, 1 / std::max(facts.recent_improvement, 1e-300));
   } else {
     const double phi = facts.keyframe_objective_end + facts.effort_end;
-    cause = format("cause: the dynamics are smooth (the gradient grows %.2gx over the horizon) and the optimiser "
-                   "stopped (",
-                   s.growth) +
-            facts.status +
-            format("), so the target is likely out of reach: inside or behind a collider, or costing more force "
-                   "than controls.alpha allows (the effort is %.0f %% of the objective); change: move the "
-                   "keyframe, give the controls more time, or lower controls.alpha",
-                   phi > 0 ? 100 * facts.effort_end / phi : 0.0);
+    const double effort_share = phi > 0 ? facts.effort_end / phi : 0.0;
+    if (effort_share > 0.5)
+      cause = format("cause: the control effort is %.0f %% of the objective: what is left of the keyframe terms "
+                     "costs less than the force that would remove it; change: raise the keyframe's weight or lower "
+                     "controls.alpha",
+                     100 * effort_share);
+    else
+      cause = format("cause: the dynamics are smooth (the gradient grows %.2gx over the horizon) and the "
+                     "optimiser stopped (",
+                     s.growth) +
+              facts.status +
+              format("), so the target is likely out of reach: inside or behind a collider, or costing more "
+                     "force than controls.alpha allows (the effort is %.0f %% of the objective); change: move the "
+                     "keyframe, give the controls more time, or lower controls.alpha",
+                     100 * effort_share);
   }
   d.line = head + what + budget + "; " + cause;
   return d;

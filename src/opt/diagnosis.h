@@ -72,6 +72,7 @@ struct RunFacts {
   double max_objective = 0;          // the largest φ any trial point gave
   double objective_start = 0;        // φ at the first evaluation
   double recent_improvement = 1;     // best φ at the end over the best φ 10 % of the evaluations earlier
+  int evaluations = 0;
 };
 
 struct Diagnosis {

@@ -105,11 +105,19 @@ TEST(Diagnosis, CauseNamesNoiseThenAmplificationThenBudgetThenReach) {
   EXPECT_NE(line.find("frame 6"), std::string::npos) << line;
   s.growth = s.growth_beyond_free = 1.5;
   RunFacts f = facts(10, 9, "evaluation limit reached");
+  f.evaluations = 300;
   f.recent_improvement = 0.5;
   line = diagnose(k, s, f).line;
-  EXPECT_NE(line.find("still improving"), std::string::npos) << line;
+  EXPECT_NE(line.find("budget ended it"), std::string::npos) << line;
+  f.recent_improvement = 1;  // stalled at a large budget: no longer the budget's fault
+  EXPECT_EQ(diagnose(k, s, f).line.find("budget ended it"), std::string::npos);
   line = diagnose(k, s, facts(10, 9)).line;
   EXPECT_NE(line.find("out of reach"), std::string::npos) << line;
+  f = facts(10, 9);
+  f.effort_end = 20;  // the effort outweighs what is left of the keyframes
+  line = diagnose(k, s, f).line;
+  EXPECT_NE(line.find("lower controls.alpha"), std::string::npos) << line;
+  EXPECT_NE(line.find("effort is 69 %"), std::string::npos) << line;
 }
 
 }  // namespace
