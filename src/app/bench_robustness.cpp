@@ -77,7 +77,7 @@ nlohmann::json bench_robustness(const RobustnessSweepOptions& o, const std::file
     ++rows;
     const std::string system = report.at("system").get<std::string>();
     auto text = [&](const char* key) { return worst->at(key).get<std::string>(); };
-    t.add({name, system.substr(0, system.find(' ')), strategy_of(report), text("name"), text("error_before"),
+    t.add({name, system.substr(0, system.find_first_of(": ")), strategy_of(report), text("name"), text("error_before"),
            text("error_after"), text("tolerance"), fmt(worst->at("miss_before").get<double>()),
            fmt(worst->at("miss_after").get<double>()), std::to_string(report.at("evaluations").get<int>()),
            fmt(seconds), report.at("diagnosis").at("outcome").get<std::string>(), pass ? "yes" : "no"});

@@ -14,8 +14,6 @@ enum ExitCode : int {
   kExitOutput = 4,       // an output could not be written
   kExitNotReady = 5,     // a subcommand that is not available yet
   kExitInterrupted = 6,  // stopped by SIGINT/SIGTERM after saving what it had
-  kExitNotReached = 7,   // optimize/run: the keyframes were not reached (no progress, or far from a target);
-                         // the run directory is written and report.json says why
   kExitInternal = 10,    // a bug: an unexpected exception
 };
 

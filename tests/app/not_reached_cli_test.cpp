@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../reliability/cli_harness.h"
+#include "app/optimize_job.h"
 #include "core/error.h"
 
 namespace kf::reliability {

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "app/optimize_job.h"
 #include "core/error.h"
 
 namespace kf {

@@ -1,6 +1,7 @@
 // The thread count changes speed only: optimising and rendering a scene with one worker thread and with
 // two gives byte-identical trajectories, controls and frames.
 #include "cli_harness.h"
+#include "app/optimize_job.h"
 #include "core/error.h"
 
 namespace kf::reliability {
