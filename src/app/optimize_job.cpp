@@ -10,7 +10,7 @@
 
 #include "adjoint/rollout.h"
 #include "app/body_meshes.h"
-#include "app/plot.h"
+#include "report/plot.h"
 #include "app/run_dir.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -18,7 +18,7 @@
 #include "core/trajectory.h"
 #include "opt/controls_file.h"
 #include "opt/diagnosis.h"
-#include "opt/measures.h"
+#include "report/figure_measures.h"
 #include "opt/optimizer.h"
 #include "sim/make_system.h"
 

@@ -6,10 +6,10 @@
 #include <fstream>
 #include <iostream>
 
-#include "app/bench_point.h"
-#include "app/bench_sweeps.h"
+#include "bench/bench_point.h"
+#include "bench/bench_sweeps.h"
 #include "app/optimize_job.h"
-#include "app/plot.h"
+#include "report/plot.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 
