@@ -132,7 +132,7 @@ CharacterSpec parse_character_spec(Block b, Scene& scene) {
   } else {
     const auto file = cape_anchors_file(c.file);
     if (!std::filesystem::exists(file))
-      b.fail("anchors", "expected an \"anchors\" block {\"mesh\", \"points\"}, or the file " + file.string() +
+      b.fail("anchors", "expected an \"anchors\" block {\"nodes\"} or {\"points\"}, or the file " + file.string() +
                             " beside the mesh");
     c.anchors = load_cape_anchors(file);
   }
