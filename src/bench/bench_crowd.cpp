@@ -10,10 +10,10 @@
 #include <fstream>
 #include <iostream>
 
-#include "app/bench_crowd.h"
-#include "app/bench_point.h"
-#include "app/bench_sweeps.h"
-#include "app/plot.h"
+#include "bench/bench_crowd.h"
+#include "bench/bench_point.h"
+#include "bench/bench_sweeps.h"
+#include "report/plot.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 
