@@ -1,6 +1,8 @@
 #include "app/optimize_job.h"
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <iomanip>
 #include <iostream>
@@ -16,8 +18,10 @@
 #include "core/progress.h"
 #include "core/trajectory.h"
 #include "opt/controls_file.h"
+#include "opt/diagnosis.h"
 #include "report/figure_measures.h"
 #include "opt/optimizer.h"
+#include "opt/windows.h"
 #include "sim/make_system.h"
 
 namespace kf {
@@ -138,6 +142,49 @@ OptimizeResult run_stage(Problem& problem, OptimizerSpec spec, int restarts, con
   return res;
 }
 
+// One stage as report.json's stage_results states it.
+struct StageResult {
+  std::string kind;  // its controls' kind
+  int substeps = 0, evaluations = 0;
+  double objective_start = 0, objective_end = 0;
+  std::string status;
+  nlohmann::json to_json() const {
+    return {{"kind", kind},
+            {"substeps", substeps},
+            {"evaluations", evaluations},
+            {"objective_start", objective_start},
+            {"objective_end", objective_end},
+            {"status", status}};
+  }
+};
+
+// The keyframe terms of an evaluation's breakdown (φ without the effort term).
+double keyframe_terms(const std::vector<std::pair<std::string, double>>& terms) {
+  double sum = 0;
+  for (const auto& [name, value] : terms)
+    if (name != "effort") sum += value;
+  return sum;
+}
+
+// What the run shows besides its keyframes: its budget, its largest trial objective, how fast it still fell.
+RunFacts run_facts(const std::string& status, const std::vector<HistoryRow>& history) {
+  RunFacts f;
+  f.status = status;
+  f.budget = status.find("limit reached") != std::string::npos;
+  if (history.empty()) return f;
+  f.objective_start = history.front().rec.phi;
+  f.evaluations = int(history.size());
+  double best = INFINITY, best_earlier = INFINITY;
+  const size_t earlier = history.size() - std::max<size_t>(1, history.size() / 10);
+  for (size_t i = 0; i < history.size(); ++i) {
+    f.max_objective = std::max(f.max_objective, history[i].rec.phi);
+    best = std::min(best, history[i].rec.phi);
+    if (i < earlier) best_earlier = std::min(best_earlier, history[i].rec.phi);
+  }
+  f.recent_improvement = std::isfinite(best_earlier) && best_earlier > 0 ? best / best_earlier : 1.0;
+  return f;
+}
+
 // What the stages leave behind.
 struct JobResult {
   VecX z;        // the best controls of the last stage
@@ -150,6 +197,8 @@ struct JobResult {
   double seconds = 0;
   double memory_budget_gb = 0;  // the run's budget
   int auto_checkpoint_every = 0;  // spacing the budget asked for in the last stage (0: none)
+  std::vector<StageResult> stages;
+  Diagnosis diagnosis;
 };
 
 // The rollout budget of a problem within a run's budget (bytes): what the optimiser's vectors leave, and the
@@ -182,13 +231,15 @@ nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, size_t 
                                 JobResult& job, const EvaluationLog& elog) {
   Problem& problem = *job.problem;
   System& sys = *job.sys;
+  // The uncontrolled run (the initial guess: no force, the scene's own initial velocities): the keyframes'
+  // errors before, and for a cape blend the end state it is measured against.
   nlohmann::json uncontrolled_stats;
-  Trajectory uncontrolled;
-  if (scene.character) {
-    problem.evaluate(problem.initial_guess(), nullptr);
-    uncontrolled = frames_of(problem.rollout(), job.time, sys.particles());
-    for (const auto& [name, value] : sys.run_stats()) uncontrolled_stats[name] = value;
-  }
+  const double uncontrolled_objective = problem.evaluate(problem.initial_guess(), nullptr);
+  const bool uncontrolled_diverged = problem.last_diverged();
+  const double uncontrolled_keyframes = uncontrolled_diverged ? uncontrolled_objective : keyframe_terms(problem.breakdown());
+  const Trajectory uncontrolled = frames_of(problem.rollout(), job.time, sys.particles());
+  for (const auto& [name, value] : sys.run_stats()) uncontrolled_stats[name] = value;
+  const nlohmann::json measures_before = figure_measures(scene, uncontrolled);
   const double final_objective = problem.evaluate(job.z, nullptr);
   const Trajectory frames = frames_of(problem.rollout(), job.time, sys.particles());
   save_controls(dir / "controls.bin", job.z, job.time.substeps);
@@ -222,6 +273,29 @@ nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, size_t 
   nlohmann::json terms = nlohmann::json::object();
   for (const auto& [name, value] : problem.breakdown()) terms[name] = value;
   report["final_terms"] = terms;
+  double effort_end = 0;
+  for (const auto& [name, value] : problem.breakdown())
+    if (name == "effort") effort_end = value;
+  const double final_keyframes = problem.last_diverged() ? final_objective : keyframe_terms(problem.breakdown());
+
+  // Whether the keyframes were reached and, if not, why (opt/diagnosis.h).
+  const std::vector<KeyframeJudgement> keyframes = judge_keyframes(scene, measures_before, report["measures"]);
+  const Sensitivity sensitivity = measure_sensitivity(scene, job.time);
+  RunFacts facts = run_facts(job.status, elog.history());
+  facts.keyframe_objective_start = uncontrolled_keyframes;
+  facts.keyframe_objective_end = final_keyframes;
+  facts.effort_end = effort_end;
+  job.diagnosis = diagnose(keyframes, sensitivity, facts);
+  report["diagnosis"] = job.diagnosis.to_json();
+  report["diagnosis"]["keyframe_objective_start"] = uncontrolled_keyframes;
+  report["diagnosis"]["keyframe_objective_end"] = final_keyframes;
+  report["diagnosis"]["budget_reached"] = facts.budget;
+  report["diagnosis"]["max_objective_evaluated"] = facts.max_objective;
+  report["keyframe_errors"] = nlohmann::json::array();
+  for (const auto& k : keyframes) report["keyframe_errors"].push_back(k.to_json());
+  report["sensitivity"] = sensitivity.to_json();
+  report["stage_results"] = nlohmann::json::array();
+  for (const auto& st : job.stages) report["stage_results"].push_back(st.to_json());
   for (const auto& [name, value] : sys.run_stats()) report["run_stats"][name] = value;
   if (scene.character) {
     report["uncontrolled_run_stats"] = uncontrolled_stats;
@@ -237,11 +311,12 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   const bool resuming = !opt.resume.empty();
   Scene scene = resuming ? load_run_scene(opt.resume) : load_scene(scene_file);
   if (!opt.adjoint.empty()) scene.optimizer.adjoint = opt.adjoint;
+  if (opt.max_seconds >= 0) scene.optimizer.max_seconds = opt.max_seconds;
   const fs::path dir = resuming ? fs::path(opt.resume) : run_dir_for(scene, opt.out);
 
   // The stages of coarse-to-fine continuation; a resumed run continues in the last stage.
-  std::vector<StageSpec> stages = scene.optimizer.schedule;
-  if (stages.empty()) stages.push_back({scene.time.substeps, scene.optimizer.max_evaluations});
+  const StagePlan plan = plan_stages(scene);
+  std::vector<StageSpec> stages = plan.stages;
   if (opt.max_evaluations >= 0)
     for (auto& s : stages) s.max_evaluations = opt.max_evaluations;
   JobResult job;
@@ -258,6 +333,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (!resuming) prepare_run_dir(dir, scene);
 
   EvaluationLog elog(opt.quiet);
+  if (!plan.why.empty() && !resuming) elog.say(plan.why);
   SignalGuard signals;
   for (size_t s = 0; s < stages.size() && !job.interrupted; ++s) {
     time.substeps = stages[s].substeps;
@@ -265,6 +341,8 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     Scene stage_scene = scene;  // a stage may optimise a coarser control parameterisation
     if (stages[s].controls) stage_scene.controls = *stages[s].controls;
     VecX& z = job.z;
+    // The first frame of the previous stage's forces (a resumed run's controls are the scene's).
+    const int z_from_frame = job.problem ? job.problem->controls().first_frame() : scene.controls.from_frame;
     VecX v0_before;  // the initial velocities the previous stage's kind gave, when the kind changes
     if (job.problem && job.problem->controls().kind() != std::string(control_kind_name(stage_scene.controls.kind)))
       job.problem->controls().initial_velocity(z, v0_before);
@@ -280,7 +358,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     if (problem.checkpoint_every() > 0) job.auto_checkpoint_every = 0;
     if (z.size() == 0) z = problem.initial_guess();
     else if (v0_before.size()) z = problem.controls().from_initial_velocity(v0_before);
-    else z = problem.controls().remap_from(z, z_time);
+    else z = problem.controls().remap_from(z, z_time, z_from_frame);
     if (z.size() != problem.size())
       throw InputError((dir / "controls.bin").string() + ": holds " + std::to_string(z.size()) +
                        " controls, the scene needs " + std::to_string(problem.size()));
@@ -289,15 +367,26 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     elog.say(std::string(resuming ? "resuming " : "optimising ") + scene.name +
              (stage_id ? " stage " + std::to_string(stage_id) : "") + ": " + job.sys->describe() + ", " +
              std::to_string(time.steps()) + " steps (h = " + std::to_string(time.h()) + " s), " +
-             std::to_string(problem.size()) + " control variables (" + problem.controls().kind() + ")");
+             std::to_string(problem.size()) + " control variables (" + problem.controls().kind() +
+             (problem.controls().first_frame() > 0 ? " from frame " + std::to_string(problem.controls().first_frame()) : "") +
+             ")");
     if (problem.checkpoint_every() == 0) elog.say(memory_line);
     OptimizerSpec spec = scene.optimizer;
     spec.max_evaluations = stages[s].max_evaluations;
+    if (spec.first_step < 0) spec.first_step = plan.scaled_first_step ? problem.control_scale() : 0;
     Progress progress("optimize " + scene.name, spec.max_evaluations);
     const OptimizeResult res = run_stage(problem, spec, scene.optimizer.restarts, z, stage_id, time.substeps,
                                          job.seconds, elog, progress);
     progress.finish();
     z = res.z;
+    StageResult st;
+    st.kind = problem.controls().kind();
+    st.substeps = time.substeps;
+    st.evaluations = res.evaluations;
+    st.objective_start = res.history.empty() ? res.phi : res.history.front().phi;
+    st.objective_end = res.phi;
+    st.status = res.status;
+    job.stages.push_back(st);
     job.seconds += res.seconds;
     job.evaluations += res.evaluations;
     job.status = res.status;
@@ -312,8 +401,11 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (opt.quiet) std::cout << tail.str() << std::endl;
   if (job.interrupted)
     elog.say("interrupted: best controls so far saved; continue with: keyframe optimize --resume " + dir.string());
+  else
+    elog.say(job.diagnosis.line);
+  if (opt.quiet && !job.interrupted && !job.diagnosis.failed()) std::cout << job.diagnosis.line << std::endl;
   write_file_atomic(dir / (resuming ? "log_resumed.txt" : "log.txt"), elog.text());
-  return {dir, job.interrupted};
+  return {dir, job.interrupted, !job.interrupted && job.diagnosis.failed(), job.diagnosis.line};
 }
 
 }  // namespace kf
