@@ -8,6 +8,7 @@
 
 #include "adjoint/rollout.h"
 #include "app/body_meshes.h"
+#include "app/memory_budget.h"
 #include "app/plot.h"
 #include "app/run_dir.h"
 #include "core/atomic_file.h"
@@ -27,17 +28,17 @@ namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop = true; }
 
-// Installs SIGINT/SIGTERM handlers for its lifetime.
+// Installs handlers for the signals that ask a job to stop (Ctrl-C, kill, a closed terminal, Ctrl-\\) for
+// its lifetime: each saves the best controls so far, as SIGINT does.
 struct SignalGuard {
-  void (*old_int)(int), (*old_term)(int);
+  static constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+  void (*old[4])(int);
   SignalGuard() {
     g_stop = false;
-    old_int = std::signal(SIGINT, on_signal);
-    old_term = std::signal(SIGTERM, on_signal);
+    for (int k = 0; k < 4; ++k) old[k] = std::signal(kSignals[k], on_signal);
   }
   ~SignalGuard() {
-    std::signal(SIGINT, old_int);
-    std::signal(SIGTERM, old_term);
+    for (int k = 0; k < 4; ++k) std::signal(kSignals[k], old[k]);
   }
 };
 
@@ -101,7 +102,8 @@ class EvaluationLog {
 // One stage of the schedule: L-BFGS from z within spec.max_evaluations, then up to `restarts` fresh starts
 // from the best point after a stalled line search, with what is left of the budget, while they make progress.
 OptimizeResult run_stage(Problem& problem, OptimizerSpec spec, int restarts, const VecX& z, int stage_id,
-                         int substeps, double seconds_before, EvaluationLog& elog, Progress& progress) {
+                         int substeps, double seconds_before, EvaluationLog& elog, Progress& progress,
+                         EvaluationTape& tape) {
   const int budget = spec.max_evaluations;
   int used = 0;       // evaluations of the earlier starts of this stage
   double before = 0;  // and their seconds
@@ -111,7 +113,7 @@ OptimizeResult run_stage(Problem& problem, OptimizerSpec spec, int restarts, con
     r.seconds += before;
     elog.record(stage_id, substeps, seconds_before, r, progress);
   };
-  OptimizeResult res = minimize(problem, spec, z, on_eval, &g_stop);
+  OptimizeResult res = minimize(problem, spec, z, on_eval, &g_stop, &tape);
   for (int k = 0; k < restarts && !res.interrupted; ++k) {
     const int left = budget - int(res.history.size());
     if (res.status.rfind("stopped: line search", 0) != 0 || left < 3) break;
@@ -122,7 +124,7 @@ OptimizeResult run_stage(Problem& problem, OptimizerSpec spec, int restarts, con
     used = int(res.history.size());
     const VecX best = res.z;
     const double best_phi = res.phi;
-    OptimizeResult more = minimize(problem, spec, best, on_eval, &g_stop);
+    OptimizeResult more = minimize(problem, spec, best, on_eval, &g_stop, &tape);
     more.seconds += before;
     more.evaluations += res.evaluations;
     more.history.insert(more.history.begin(), res.history.begin(), res.history.end());
@@ -139,6 +141,7 @@ OptimizeResult run_stage(Problem& problem, OptimizerSpec spec, int restarts, con
 
 // What the stages leave behind.
 struct JobResult {
+  EvaluationTape tape;  // every evaluation, for a resume that continues exactly where this run stopped
   VecX z;        // the best controls of the last stage
   TimeSpec time;  // its time discretisation
   std::unique_ptr<System> sys;
@@ -166,6 +169,9 @@ nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, size_t 
   const double final_objective = problem.evaluate(job.z, nullptr);
   const Trajectory frames = frames_of(problem.rollout(), job.time, sys.particles());
   save_controls(dir / "controls.bin", job.z, job.time.substeps);
+  std::error_code ec;
+  if (job.tape.complete()) save_evaluations(dir / "evaluations.bin", job.tape.records());
+  else fs::remove(dir / "evaluations.bin", ec);  // too large to keep: a resume restarts from controls.bin
   save_trajectory(dir / "trajectory.bin", frames);
   write_body_meshes(scene, frames.frames(), dir / "meshes.bin");
   const auto& history = elog.history();
@@ -184,6 +190,7 @@ nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, size_t 
                            {"adjoint", scene.optimizer.adjoint},
                            {"stages", stages},
                            {"resumed", resuming},
+                           {"replayed_evaluations", job.tape.replayed()},
                            {"status", job.status},
                            {"interrupted", job.interrupted},
                            {"evaluations", job.evaluations},
@@ -218,16 +225,36 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     for (auto& s : stages) s.max_evaluations = opt.max_evaluations;
   JobResult job;
   TimeSpec z_time = scene.time;
-  if (resuming) {
+  // A run that kept its evaluations resumes by replaying them from the start (the same path, budget and
+  // result as if it had not stopped); an older one continues its last stage from controls.bin.
+  const bool replaying = resuming && fs::exists(dir / "evaluations.bin");
+  if (replaying) {
+    job.tape.set_replay(load_evaluations(dir / "evaluations.bin"));
+  } else if (resuming) {
     job.z = load_controls(dir / "controls.bin", &z_time.substeps);
     stages.erase(stages.begin(), stages.end() - 1);
+  }
+  {
+    const std::uint64_t limit = opt.max_memory.empty() ? 0 : parse_memory_size(opt.max_memory);
+    const int every = opt.checkpoint_every >= 0 ? opt.checkpoint_every : scene.optimizer.checkpoint_every;
+    MemoryEstimate need;
+    for (const auto& st : stages) {
+      const MemoryEstimate e = optimize_memory(scene, st.substeps, every);
+      if (e.bytes > need.bytes) need = e;
+    }
+    check_memory(scene, need, limit);
   }
   // Build the first system before writing anything, so bad scenes leave no trace.
   TimeSpec& time = job.time;
   time = scene.time;
   time.substeps = stages[0].substeps;
   job.sys = make_system(scene, time.h());
-  if (!resuming) prepare_run_dir(dir, scene);
+  // The new run is written beside the old one and swapped in at the end (locked meanwhile), so a failed or
+  // killed job leaves an existing run directory as it was.
+  StagedDir staged(dir);
+  const fs::path work = staged.path();
+  if (resuming) staged.copy_from_target([](const std::string&) { return true; });
+  else naming_run_dir(staged, [&] { prepare_run_dir(work, scene); });
 
   EvaluationLog elog(opt.quiet);
   SignalGuard signals;
@@ -259,7 +286,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     spec.max_evaluations = stages[s].max_evaluations;
     Progress progress("optimize " + scene.name, spec.max_evaluations);
     const OptimizeResult res = run_stage(problem, spec, scene.optimizer.restarts, z, stage_id, time.substeps,
-                                         job.seconds, elog, progress);
+                                         job.seconds, elog, progress, job.tape);
     progress.finish();
     z = res.z;
     job.seconds += res.seconds;
@@ -268,7 +295,8 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     job.interrupted = res.interrupted;
   }
 
-  const nlohmann::json report = write_run_report(dir, scene, stages.size(), resuming, job, elog);
+  nlohmann::json report;
+  naming_run_dir(staged, [&] { report = write_run_report(work, scene, stages.size(), resuming, job, elog); });
   std::ostringstream tail;
   tail << job.status << " after " << job.evaluations << " evaluations in " << std::fixed << std::setprecision(2)
        << job.seconds << " s; objective " << std::scientific << report["final_objective"].get<double>();
@@ -276,7 +304,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (opt.quiet) std::cout << tail.str() << std::endl;
   if (job.interrupted)
     elog.say("interrupted: best controls so far saved; continue with: keyframe optimize --resume " + dir.string());
-  write_file_atomic(dir / (resuming ? "log_resumed.txt" : "log.txt"), elog.text());
+  commit_run_dir(staged, [&](const fs::path& w) { write_file_atomic(w / (resuming ? "log_resumed.txt" : "log.txt"), elog.text()); });
   return {dir, job.interrupted};
 }
 

@@ -16,6 +16,7 @@ struct OptimizeOptions {
   std::string resume;         // run directory to continue from (its scene.json and controls.bin)
   int checkpoint_every = -1;  // override the scene's optimizer.checkpoint_every when >= 0
   std::string adjoint;        // override the scene's optimizer.adjoint when not empty ("exact" | "swap")
+  std::string max_memory;     // refuse a run estimated to need more ("4G"); "" = the machine's memory
 };
 
 struct OptimizeOutcome {
