@@ -29,7 +29,10 @@ void add_compare_command(CLI::App& app) {
   sub->add_option("--out", req->out_dir, "reports and diff images (default: compare/ beside the frames directory)");
   sub->add_flag("--update", req->update, "accept the frames: copy each new or changed frame over its reference");
   sub->footer("Defaults demand identical pixels (same scene, seed and back end give the same frames).\n"
-              "Example: keyframe render out/square && keyframe compare out/square tests/reference/square");
+              "Example:\n"
+              "  keyframe render out/square\n"
+              "  keyframe compare out/square refs/square --update   # the first time: keep these frames as references\n"
+              "  keyframe compare out/square refs/square            # later: exit 1 and diff images on a change");
   sub->callback([=] {
     render::CompareRequest r = *req;
     if (*noise) {

@@ -1,7 +1,8 @@
-// The README's numbers against the committed results they come from. A value or table the README shows is
-// written as <!--gen:COMMAND-->TEXT<!--/gen--> (the comment is invisible on the rendered page); COMMAND runs
-// in the repository root (usually scripts/result or a summary script over tests/results/) and TEXT must be
-// what it prints. KEYFRAME_UPDATE_README=1 rewrites every TEXT from its command instead of checking.
+// The numbers of the README and of the measurement report (tests/results/REPORT.md) against the committed
+// results they come from. A value or table shown there is written as <!--gen:COMMAND-->TEXT<!--/gen--> (the
+// comment is invisible on the rendered page); COMMAND runs in the repository root (usually scripts/result or
+// a summary script over tests/results/) and TEXT must be what it prints. KEYFRAME_UPDATE_README=1 rewrites
+// every TEXT from its command instead of checking.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -35,7 +36,7 @@ std::string trimmed(const std::string& s) {
 
 int line_of(const std::string& text, size_t pos) { return 1 + int(std::count(text.begin(), text.begin() + pos, '\n')); }
 
-std::vector<Generated> generated_parts(const std::string& readme) {
+std::vector<Generated> generated_parts(const std::string& readme, const std::string& name = "README.md") {
   std::vector<Generated> out;
   for (size_t at = readme.find(kOpen); at != std::string::npos; at = readme.find(kOpen, at + 1)) {
     const size_t end_cmd = readme.find("-->", at);
@@ -43,11 +44,11 @@ std::vector<Generated> generated_parts(const std::string& readme) {
     const size_t next = readme.find(kOpen, at + 1);
     if (end_cmd == std::string::npos || close == std::string::npos || close < end_cmd ||
         (next != std::string::npos && next < close))
-      throw std::runtime_error("README.md:" + std::to_string(line_of(readme, at)) + ": " + kOpen +
+      throw std::runtime_error(name + ":" + std::to_string(line_of(readme, at)) + ": " + kOpen +
                                " without its " + kClose);
     const std::string command = readme.substr(at + kOpen.size(), end_cmd - at - kOpen.size());
     if (command.find("--") != std::string::npos)
-      throw std::runtime_error("README.md:" + std::to_string(line_of(readme, at)) +
+      throw std::runtime_error(name + ":" + std::to_string(line_of(readme, at)) +
                                ": \"--\" ends an HTML comment early; use KEY=VALUE options");
     out.push_back({command, end_cmd + 3, close});
   }
@@ -67,14 +68,14 @@ std::string output_of(const std::string& command) {
   return cache[command] = out;
 }
 
-// One line per README value that differs from its command's output.
-std::vector<std::string> mismatches(const std::string& readme) {
+// One line per value of `readme` (a file called `name`) that differs from its command's output.
+std::vector<std::string> mismatches(const std::string& readme, const std::string& name = "README.md") {
   std::vector<std::string> out;
-  for (const Generated& g : generated_parts(readme)) {
+  for (const Generated& g : generated_parts(readme, name)) {
     const std::string shown = trimmed(readme.substr(g.text_begin, g.text_end - g.text_begin));
     const std::string wanted = trimmed(output_of(g.command));
     if (shown != wanted)
-      out.push_back("README.md:" + std::to_string(line_of(readme, g.text_begin)) + ": shows \"" + shown +
+      out.push_back(name + ":" + std::to_string(line_of(readme, g.text_begin)) + ": shows \"" + shown +
                     "\" but `" + g.command + "` gives \"" + wanted + "\"");
   }
   return out;
@@ -94,40 +95,54 @@ std::string regenerated(const std::string& readme) {
   return out + readme.substr(copied);
 }
 
-std::string readme_text() {
-  std::ifstream in(KEYFRAME_SOURCE_DIR "/README.md", std::ios::binary);
+// The checked documents, from the repository root, with how many values each must at least hold (so that a
+// lost marker block is noticed).
+struct Document {
+  const char* path;
+  size_t min_values;
+};
+constexpr std::array<Document, 2> kDocuments{{{"README.md", 10}, {"tests/results/REPORT.md", 60}}};
+
+std::string text_of(const std::string& path) {
+  std::ifstream in(std::string(KEYFRAME_SOURCE_DIR "/") + path, std::ios::binary);
   std::ostringstream os;
   os << in.rdbuf();
   return os.str();
 }
 
 TEST(Readme, EveryCheckedValueMatchesTheCommittedResults) {
-  const std::string readme = readme_text();
   if (std::getenv("KEYFRAME_UPDATE_README")) {
-    write_file_atomic(KEYFRAME_SOURCE_DIR "/README.md", regenerated(readme));
-    GTEST_SKIP() << "rewrote README.md from its commands";
+    for (const Document& d : kDocuments)
+      write_file_atomic(std::string(KEYFRAME_SOURCE_DIR "/") + d.path, regenerated(text_of(d.path)));
+    GTEST_SKIP() << "rewrote README.md and tests/results/REPORT.md from their commands";
   }
-  const auto parts = generated_parts(readme);
-  EXPECT_GE(parts.size(), 20u) << "the README's checked values have gone missing";
-  for (const std::string& m : mismatches(readme)) ADD_FAILURE() << m;
+  for (const Document& d : kDocuments) {
+    const std::string text = text_of(d.path);
+    ASSERT_FALSE(text.empty()) << d.path << " is missing";
+    EXPECT_GE(generated_parts(text, d.path).size(), d.min_values) << d.path << "'s checked values have gone missing";
+    for (const std::string& m : mismatches(text, d.path)) ADD_FAILURE() << m;
+  }
 }
 
 TEST(Readme, AHandEditedValueOrAnUnclosedMarkerFails) {
-  const std::string readme = readme_text();
-  const auto parts = generated_parts(readme);
-  ASSERT_FALSE(parts.empty());
-  // Change the first digit of every checked value in turn: each edit alone is caught.
-  int edited = 0;
-  for (const Generated& g : parts) {
-    std::string copy = readme;
-    size_t d = copy.find_first_of("0123456789", g.text_begin);
-    if (d == std::string::npos || d >= g.text_end) continue;
-    copy[d] = copy[d] == '9' ? '8' : char(copy[d] + 1);
-    const auto found = mismatches(copy);
-    EXPECT_EQ(found.size(), 1u) << "an edit at README.md:" << line_of(readme, d) << " went unnoticed";
-    if (++edited == 5) break;  // each check runs every command: five edits are enough
+  for (const Document& d : kDocuments) {
+    const std::string text = text_of(d.path);
+    const auto parts = generated_parts(text, d.path);
+    ASSERT_FALSE(parts.empty()) << d.path;
+    // Change the first digit of a checked value: each edit alone is caught.
+    int edited = 0;
+    for (const Generated& g : parts) {
+      std::string copy = text;
+      size_t digit = copy.find_first_of("0123456789", g.text_begin);
+      if (digit == std::string::npos || digit >= g.text_end) continue;
+      copy[digit] = copy[digit] == '9' ? '8' : char(copy[digit] + 1);
+      const auto found = mismatches(copy, d.path);
+      ASSERT_EQ(found.size(), 1u) << "an edit at " << d.path << ":" << line_of(text, digit) << " went unnoticed";
+      EXPECT_EQ(found[0].rfind(std::string(d.path) + ":" + std::to_string(line_of(text, digit)) + ":", 0), 0u) << found[0];
+      if (++edited == 3) break;  // each check runs every command: three edits a document are enough
+    }
+    EXPECT_EQ(edited, 3) << d.path;
   }
-  EXPECT_EQ(edited, 5);
   EXPECT_THROW(generated_parts("a <!--gen:echo 1-->1 and no close"), std::runtime_error);
   EXPECT_THROW(generated_parts("<!--gen:scripts/result x.csv y --fmt %d-->1<!--/gen-->"), std::runtime_error);
   EXPECT_EQ(regenerated("x <!--gen:echo 2-->1<!--/gen--> y"), "x <!--gen:echo 2-->2<!--/gen--> y");
@@ -149,7 +164,7 @@ std::vector<std::string> csv_fields(const std::string& line) {
 
 // What is wrong with the stamps of the results under `dir` (its stamps.csv: file,date,commit,machine,
 // load_1min,load,note): a file without a row, a row without date, commit, machine or load, a row for a
-// file that is not there. README.md and stamps.csv themselves need none.
+// file that is not there. README.md, REPORT.md and stamps.csv themselves need none.
 std::vector<std::string> stamp_problems(const std::filesystem::path& dir) {
   namespace fs = std::filesystem;
   std::vector<std::string> out;
@@ -172,7 +187,7 @@ std::vector<std::string> stamp_problems(const std::filesystem::path& dir) {
   for (const auto& e : fs::recursive_directory_iterator(dir)) {
     if (!e.is_regular_file()) continue;
     const std::string rel = fs::relative(e.path(), dir).generic_string();
-    if (rel != "README.md" && rel != "stamps.csv" && !rows.count(rel)) out.push_back(rel + " has no stamp in stamps.csv");
+    if (rel != "README.md" && rel != "REPORT.md" && rel != "stamps.csv" && !rows.count(rel)) out.push_back(rel + " has no stamp in stamps.csv");
   }
   return out;
 }
