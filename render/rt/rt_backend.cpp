@@ -193,6 +193,88 @@ class RtBackend final : public Backend {
     r.flags[l] = 0;
   }
 
+  // Where lane l's primary ray hit: the normal facing the ray (shading n, geometric ng), the colour of the side
+  // seen, and the point lifted off the surface by eps.
+  struct SurfacePoint {
+    V3 n, ng, p, albedo;
+  };
+  SurfacePoint surface_point(const Shading& sh, const RTCRayHit8& rh, int l) const {
+    const V3 dir{rh.ray.dir_x[l], rh.ray.dir_y[l], rh.ray.dir_z[l]};
+    const Mesh* m = nullptr;
+    for (const auto& rm : meshes_)
+      if (rm.id == rh.hit.geomID[l]) m = rm.source;
+    const uint32_t* tri = &m->indices[size_t(rh.hit.primID[l]) * 3];
+    const Vertex &a = m->vertices[tri[0]], &b = m->vertices[tri[1]], &c = m->vertices[tri[2]];
+    const float u = rh.hit.u[l], v = rh.hit.v[l], w = 1.0f - u - v;
+    SurfacePoint s;
+    s.n = normalize(from(a.n) * w + from(b.n) * u + from(c.n) * v);
+    s.albedo = from(a.front) * w + from(b.front) * u + from(c.front) * v;
+    if (dot(s.n, dir) > 0.0f) {  // seen from behind: the other side's colour
+      s.n = s.n * -1.0f;
+      s.albedo = from(a.back) * w + from(b.back) * u + from(c.back) * v;
+    }
+    s.ng = normalize(V3{rh.hit.Ng_x[l], rh.hit.Ng_y[l], rh.hit.Ng_z[l]});
+    if (dot(s.ng, dir) > 0.0f) s.ng = s.ng * -1.0f;
+    s.p = sh.eye + dir * rh.ray.tfar[l] + s.ng * sh.eps;
+    return s;
+  }
+
+  // Sun: a point on a disc of directions around the light direction. Sets n.l and, when the sun is above
+  // the surface, lane l's shadow ray.
+  static void sample_sun(const Shading& sh, const SurfacePoint& s, Rng& rng, int l, float& ndl, int* valid,
+                         RTCRay8& rays) {
+    const float r = sh.sun_radius * std::sqrt(rng.next());
+    float c, sn;
+    rng.angle(c, sn);
+    const V3 d = normalize(sh.sun + sh.sun_t * (r * c) + sh.sun_b * (r * sn));
+    ndl = dot(s.n, d);
+    if (ndl > 0.0f) {
+      valid[l] = -1;
+      set_ray(rays, l, s.p, d, INFINITY);
+    }
+  }
+
+  // Sky: a cosine-weighted direction, occluded within a short distance.
+  static void sample_sky(const Shading& sh, const SurfacePoint& s, Rng& rng, int l, float& weight, int* valid,
+                         RTCRay8& rays) {
+    V3 t, bt;
+    orthonormal(s.n, t, bt);
+    const float r1 = rng.next(), rr = std::sqrt(r1);
+    float c, sn;
+    rng.angle(c, sn);
+    const V3 d = t * (rr * c) + bt * (rr * sn) + s.n * std::sqrt(1.0f - r1);  // unit: t, bt, n are
+    weight = sky_light(s.n.y);
+    if (dot(d, s.ng) > 0.0f) {
+      valid[l] = -1;
+      set_ray(rays, l, s.p, d, sh.ao_distance);
+    }
+  }
+
+  // The primary rays of one sample of pixels x0..x0+7 of row y (valid lanes only), jittered within each pixel.
+  static void set_primary_rays(const Shading& sh, int x0, int y, int W, int H, const int* valid, Rng* rng,
+                               RTCRayHit8& rh) {
+    for (int l = 0; l < kLanes; ++l) {
+      if (!valid[l]) continue;
+      const float px = (float(x0 + l) + rng[l].next()) / float(W) * 2.0f - 1.0f;
+      const float py = 1.0f - (float(y) + rng[l].next()) / float(H) * 2.0f;
+      set_ray(rh.ray, l, sh.eye, normalize(sh.forward + sh.right * px + sh.up * py), INFINITY);
+      rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+    }
+  }
+
+  // The mean of each valid lane's `spp` samples, as 8-bit RGB.
+  static void write_lanes(const V3* sum, const int* valid, int x0, int y, int spp, Image& img) {
+    for (int l = 0; l < kLanes; ++l) {
+      if (!valid[l]) continue;
+      const V3 c = sum[l] * (1.0f / float(spp));
+      uint8_t* out = img.at(x0 + l, y);
+      out[0] = uint8_t(std::lround(std::clamp(c.x, 0.0f, 1.0f) * 255.0f));
+      out[1] = uint8_t(std::lround(std::clamp(c.y, 0.0f, 1.0f) * 255.0f));
+      out[2] = uint8_t(std::lround(std::clamp(c.z, 0.0f, 1.0f) * 255.0f));
+    }
+  }
+
   // Pixels x..x+7 of row y (those inside the image), spp samples each, written into `img`.
   void shade_packet(const Shading& sh, int x0, int y, int W, int H, int spp, Image& img) const {
     alignas(32) int valid[kLanes], sun_valid[kLanes], sky_valid[kLanes];
@@ -212,14 +294,7 @@ class RtBackend final : public Backend {
     alignas(32) RTCRayHit8 rh;
     alignas(32) RTCRay8 sun_rays, sky_rays;
     for (int s = 0; s < spp; ++s) {
-      for (int l = 0; l < kLanes; ++l) {
-        if (!valid[l]) continue;
-        const float px = (float(x0 + l) + rng[l].next()) / float(W) * 2.0f - 1.0f;
-        const float py = 1.0f - (float(y) + rng[l].next()) / float(H) * 2.0f;
-        set_ray(rh.ray, l, sh.eye, normalize(sh.forward + sh.right * px + sh.up * py), INFINITY);
-        rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
-      }
+      set_primary_rays(sh, x0, y, W, H, valid, rng, rh);
       rtcIntersect8(valid, scene_.get(), &primary_ctx, &rh);
       for (int l = 0; l < kLanes; ++l) {
         sun_valid[l] = sky_valid[l] = 0;
@@ -228,48 +303,10 @@ class RtBackend final : public Backend {
           sum[l] = sum[l] + sh.background;
           continue;
         }
-        const V3 dir{rh.ray.dir_x[l], rh.ray.dir_y[l], rh.ray.dir_z[l]};
-        const Mesh* m = nullptr;
-        for (const auto& rm : meshes_)
-          if (rm.id == rh.hit.geomID[l]) m = rm.source;
-        const uint32_t* tri = &m->indices[size_t(rh.hit.primID[l]) * 3];
-        const Vertex &a = m->vertices[tri[0]], &b = m->vertices[tri[1]], &c = m->vertices[tri[2]];
-        const float u = rh.hit.u[l], v = rh.hit.v[l], w = 1.0f - u - v;
-        V3 n = normalize(from(a.n) * w + from(b.n) * u + from(c.n) * v);
-        albedo[l] = from(a.front) * w + from(b.front) * u + from(c.front) * v;
-        if (dot(n, dir) > 0.0f) {  // seen from behind: the other side's colour
-          n = n * -1.0f;
-          albedo[l] = from(a.back) * w + from(b.back) * u + from(c.back) * v;
-        }
-        V3 ng = normalize(V3{rh.hit.Ng_x[l], rh.hit.Ng_y[l], rh.hit.Ng_z[l]});
-        if (dot(ng, dir) > 0.0f) ng = ng * -1.0f;
-        const V3 p = sh.eye + dir * rh.ray.tfar[l] + ng * sh.eps;
-        // Sun: a point on a disc of directions around the light direction.
-        {
-          const float r = sh.sun_radius * std::sqrt(rng[l].next());
-          float c, sn;
-          rng[l].angle(c, sn);
-          const V3 d = normalize(sh.sun + sh.sun_t * (r * c) + sh.sun_b * (r * sn));
-          ndl[l] = dot(n, d);
-          if (ndl[l] > 0.0f) {
-            sun_valid[l] = -1;
-            set_ray(sun_rays, l, p, d, INFINITY);
-          }
-        }
-        // Sky: cosine-weighted direction, occluded within a short distance.
-        {
-          V3 t, bt;
-          orthonormal(n, t, bt);
-          const float r1 = rng[l].next(), rr = std::sqrt(r1);
-          float c, sn;
-          rng[l].angle(c, sn);
-          const V3 d = t * (rr * c) + bt * (rr * sn) + n * std::sqrt(1.0f - r1);  // unit: t, bt, n are
-          sky_weight[l] = sky_light(n.y);
-          if (dot(d, ng) > 0.0f) {
-            sky_valid[l] = -1;
-            set_ray(sky_rays, l, p, d, sh.ao_distance);
-          }
-        }
+        const SurfacePoint sp = surface_point(sh, rh, l);
+        albedo[l] = sp.albedo;
+        sample_sun(sh, sp, rng[l], l, ndl[l], sun_valid, sun_rays);
+        sample_sky(sh, sp, rng[l], l, sky_weight[l], sky_valid, sky_rays);
       }
       rtcOccluded8(sun_valid, scene_.get(), &shadow_ctx, &sun_rays);
       rtcOccluded8(sky_valid, scene_.get(), &shadow_ctx, &sky_rays);
@@ -281,14 +318,7 @@ class RtBackend final : public Backend {
         sum[l] = sum[l] + albedo[l] * ((sh.ambient * sky + sun) * sh.norm_k);
       }
     }
-    for (int l = 0; l < kLanes; ++l) {
-      if (!valid[l]) continue;
-      const V3 c = sum[l] * (1.0f / float(spp));
-      uint8_t* out = img.at(x0 + l, y);
-      out[0] = uint8_t(std::lround(std::clamp(c.x, 0.0f, 1.0f) * 255.0f));
-      out[1] = uint8_t(std::lround(std::clamp(c.y, 0.0f, 1.0f) * 255.0f));
-      out[2] = uint8_t(std::lround(std::clamp(c.z, 0.0f, 1.0f) * 255.0f));
-    }
+    write_lanes(sum, valid, x0, y, spp, img);
   }
 
   EmbreeDevice device_;

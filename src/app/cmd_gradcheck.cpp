@@ -11,23 +11,56 @@
 
 namespace kf {
 
-void add_gradcheck_command(CLI::App& app) {
-  auto* sub = app.add_subcommand(
-      "gradcheck",
-      "compare the adjoint gradient with central finite differences on a sample of control coordinates (steps 4 "
-      "eps, 2 eps, eps, eps/2, ... Richardson-extrapolated, until two extrapolations agree or the objective's round-off "
-      "takes over); samples whose estimates never agree to --kink-tolerance straddle a kink of the objective and "
-      "are counted as kinks, not as adjoint error; fd_spread is the check's own resolution; prints one JSON "
-      "object (checked, kinks, max_rel_error, cosine, rel_error_norm, fd_spread, phi_noise, ...)");
-  struct Options {
-    std::string scene;
-    int samples = 40, frames = 0, substeps = 0;
-    double eps = 1e-4, dt = 0, perturb = 0.1, kink_tolerance = 1e-2;
-    std::string solver = "direct";
-    unsigned seed = 7;
-    std::string adjoint;
-  };
-  auto o = std::make_shared<Options>();
+namespace {
+
+struct GradcheckCommandOptions {
+  std::string scene;
+  int samples = 40, frames = 0, substeps = 0;
+  double eps = 1e-4, dt = 0, perturb = 0.1, kink_tolerance = 1e-2;
+  std::string solver = "direct";
+  unsigned seed = 7;
+  std::string adjoint;
+};
+
+// The scene as the check runs it: shortened, resampled in time, with the requested adjoint and solve.
+Scene gradcheck_scene(const GradcheckCommandOptions& o) {
+  Scene scene = shortened(load_scene(o.scene), o.frames);
+  if (o.substeps > 0) scene.time.substeps = o.substeps;
+  if (!o.adjoint.empty()) scene.optimizer.adjoint = o.adjoint;
+  if (scene.cloth && o.solver == "direct") scene.cloth->solver = "direct";
+  if (o.dt > 0) {
+    const double n = 1.0 / (scene.time.fps * o.dt);
+    if (std::abs(n - std::round(n)) > 1e-6 || std::round(n) < 1)
+      throw InputError("--dt " + std::to_string(o.dt) + ": expected a step that divides the frame time 1/" +
+                       std::to_string(scene.time.fps) + " s");
+    scene.time.substeps = int(std::round(n));
+  }
+  return scene;
+}
+
+void run_gradcheck(const GradcheckCommandOptions& o) {
+  const Scene scene = gradcheck_scene(o);
+  auto sys = make_system(scene, scene.time.h());
+  Problem problem(scene, scene.time, *sys);
+  VecX z = problem.initial_guess();
+  std::mt19937_64 rng(o.seed);
+  std::normal_distribution<double> normal(0.0, o.perturb);
+  for (int i = 0; i < z.size(); ++i) z[i] += normal(rng);
+  const GradcheckResult r = gradcheck(
+      problem, z, {.samples = o.samples, .eps = o.eps, .kink_tolerance = o.kink_tolerance, .seed = o.seed});
+  nlohmann::json j = r.to_json();
+  j["scene"] = scene.name;
+  j["h"] = scene.time.h();
+  j["steps"] = scene.time.steps();
+  j["control_variables"] = problem.size();
+  if (scene.cloth) {
+    j["adjoint"] = scene.optimizer.adjoint;
+    j["solver"] = scene.cloth->solver;
+  }
+  std::cout << j.dump() << "\n";
+}
+
+void add_gradcheck_options(CLI::App* sub, const std::shared_ptr<GradcheckCommandOptions>& o) {
   sub->add_option("SCENE", o->scene, "scene file (JSON)")->required();
   sub->add_option("--samples", o->samples, "coordinates to compare")->check(CLI::Range(1, 100000));
   sub->add_option("--eps", o->eps, "the finite-difference step completing the first extrapolation (steps start at 4 eps), relative to max(1, |z|)")
@@ -55,37 +88,21 @@ void add_gradcheck_command(CLI::App& app) {
   sub->add_option("--adjoint", o->adjoint, "cloth adjoint: exact (the step's own Jacobian) or swap (the paper's "
                                            "integrator swap); default: the scene's optimizer.adjoint")
       ->check(CLI::IsMember({"exact", "swap"}));
-  sub->callback([o] {
-    Scene scene = shortened(load_scene(o->scene), o->frames);
-    if (o->substeps > 0) scene.time.substeps = o->substeps;
-    if (!o->adjoint.empty()) scene.optimizer.adjoint = o->adjoint;
-    if (scene.cloth && o->solver == "direct") scene.cloth->solver = "direct";
-    if (o->dt > 0) {
-      const double n = 1.0 / (scene.time.fps * o->dt);
-      if (std::abs(n - std::round(n)) > 1e-6 || std::round(n) < 1)
-        throw InputError("--dt " + std::to_string(o->dt) + ": expected a step that divides the frame time 1/" +
-                         std::to_string(scene.time.fps) + " s");
-      scene.time.substeps = int(std::round(n));
-    }
-    auto sys = make_system(scene, scene.time.h());
-    Problem problem(scene, scene.time, *sys);
-    VecX z = problem.initial_guess();
-    std::mt19937_64 rng(o->seed);
-    std::normal_distribution<double> normal(0.0, o->perturb);
-    for (int i = 0; i < z.size(); ++i) z[i] += normal(rng);
-    const GradcheckResult r = gradcheck(
-        problem, z, {.samples = o->samples, .eps = o->eps, .kink_tolerance = o->kink_tolerance, .seed = o->seed});
-    nlohmann::json j = r.to_json();
-    j["scene"] = scene.name;
-    j["h"] = scene.time.h();
-    j["steps"] = scene.time.steps();
-    j["control_variables"] = problem.size();
-    if (scene.cloth) {
-      j["adjoint"] = scene.optimizer.adjoint;
-      j["solver"] = scene.cloth->solver;
-    }
-    std::cout << j.dump() << "\n";
-  });
+}
+
+}  // namespace
+
+void add_gradcheck_command(CLI::App& app) {
+  auto* sub = app.add_subcommand(
+      "gradcheck",
+      "compare the adjoint gradient with central finite differences on a sample of control coordinates (steps 4 "
+      "eps, 2 eps, eps, eps/2, ... Richardson-extrapolated, until two extrapolations agree or the objective's round-off "
+      "takes over); samples whose estimates never agree to --kink-tolerance straddle a kink of the objective and "
+      "are counted as kinks, not as adjoint error; fd_spread is the check's own resolution; prints one JSON "
+      "object (checked, kinks, max_rel_error, cosine, rel_error_norm, fd_spread, phi_noise, ...)");
+  auto o = std::make_shared<GradcheckCommandOptions>();
+  add_gradcheck_options(sub, o);
+  sub->callback([o] { run_gradcheck(*o); });
 }
 
 }  // namespace kf

@@ -17,7 +17,7 @@
 
 #include "app/optimize_job.h"
 #include "opt/gradcheck.h"
-#include "opt/measures.h"
+#include "report/figure_measures.h"
 #include "opt/optimizer.h"
 #include "opt/problem.h"
 #include "scene/scene.h"

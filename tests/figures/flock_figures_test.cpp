@@ -8,7 +8,7 @@
 #include <string>
 
 #include "opt/gradcheck.h"
-#include "opt/measures.h"
+#include "report/figure_measures.h"
 #include "opt/objective_terms.h"
 #include "opt/optimizer.h"
 #include "opt/problem.h"

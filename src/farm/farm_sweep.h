@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/slurm.h"
+#include "farm/slurm.h"
 
 namespace kf::farm {
 

@@ -1,9 +1,10 @@
-#include "opt/measures.h"
+#include "report/figure_measures.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "core/check.h"
 #include "core/overloaded.h"
 #include "opt/objective_terms.h"
 #include "sim/cloth/collider.h"
@@ -189,8 +190,28 @@ nlohmann::json sheet_measures(const ClothSpec& cloth, const Trajectory& t) {
 
 }  // namespace
 
+namespace {
+
+// A collider's own measures over a run (null for shapes that have none): a ring's crossing, a free sheet's
+// landing on the ground.
+nlohmann::json collider_measures(const ClothSpec& cloth, const ColliderSpec& c, const Trajectory& t) {
+  return std::visit(Overloaded{
+                        [&](const TorusShape& torus) { return ring_measures(torus, t); },
+                        [&](const GroundShape& ground) {
+                          return cloth.pins.empty() ? ground_measures(ground, c.thickness, t) : nlohmann::json();
+                        },
+                        [](const SphereShape&) { return nlohmann::json(); },
+                        [](const CapsuleShape&) { return nlohmann::json(); },
+                    },
+                    c.shape);
+}
+
+}  // namespace
+
 nlohmann::json figure_measures(const Scene& scene, const Trajectory& t) {
   nlohmann::json out = nlohmann::json::array();
+  CHECK_GT(t.frames(), 0);
+  CHECK_EQ(t.particles, scene.particles());
   const int last = t.frames() - 1;
   for (const auto& o : scene.objectives) {
     const int f = std::min(o.frame, last);
@@ -214,17 +235,12 @@ nlohmann::json figure_measures(const Scene& scene, const Trajectory& t) {
                           [](const FlockSpec&) {},
                           [&](const ClothSpec& cloth) {
                             if (cloth.pins.empty()) out.push_back(sheet_measures(cloth, t));
-                            for (size_t k = 0; k < cloth.colliders.size(); ++k)
-                              if (const auto* torus = std::get_if<TorusShape>(&cloth.colliders[k].shape)) {
-                                nlohmann::json m = ring_measures(*torus, t);
-                                m["collider"] = int(k);
-                                out.push_back(m);
-                              } else if (const auto* ground = std::get_if<GroundShape>(&cloth.colliders[k].shape)) {
-                                if (!cloth.pins.empty()) continue;  // a free sheet's landing
-                                nlohmann::json m = ground_measures(*ground, cloth.colliders[k].thickness, t);
-                                m["collider"] = int(k);
-                                out.push_back(m);
-                              }
+                            for (size_t k = 0; k < cloth.colliders.size(); ++k) {
+                              nlohmann::json m = collider_measures(cloth, cloth.colliders[k], t);
+                              if (m.is_null()) continue;
+                              m["collider"] = int(k);
+                              out.push_back(m);
+                            }
                           },
                       });
   return out;
@@ -275,6 +291,34 @@ nlohmann::json ground_measures(const GroundShape& ground, double thickness, cons
           {"on_ground_at_end", lowest <= 2 * thickness}};
 }
 
+namespace {
+
+// The smallest signed distance to the ring along each particle's straight path from one frame to the next
+// (at most `so_far`). The simulation's contacts act only at steps, so a fast particle could pass through
+// the tube unseen by the frames. Paths whose whole length is farther from the surface than their half length
+// cannot come closer than that; the others are sampled at `spacing` (m).
+double min_distance_between_frames(const TorusCollider& ring, const Trajectory& t, double spacing, double so_far) {
+  double min_between = so_far;
+  for (int f = 0; f + 1 < t.frames(); ++f)
+    for (int i = 0; i < t.x[size_t(f)].size() / 3; ++i) {
+      const Vec3 a = seg(t.x[size_t(f)], i), b = seg(t.x[size_t(f) + 1], i);
+      double phi;
+      Vec3 n;
+      Mat3 dn;
+      ring.distance(0.5 * (a + b), phi, n, dn);
+      const double half = 0.5 * (b - a).norm();
+      if (phi - half >= min_between) continue;  // cannot lower the minimum
+      const int samples = 1 + int(std::ceil(2 * half / spacing));
+      for (int k = 0; k <= samples; ++k) {
+        ring.distance(a + (b - a) * (double(k) / samples), phi, n, dn);
+        min_between = std::min(min_between, phi);
+      }
+    }
+  return min_between;
+}
+
+}  // namespace
+
 nlohmann::json ring_measures(const TorusShape& torus, const Trajectory& t) {
   const TorusCollider ring(torus, 0.0, 0.0, 0.0);  // distances only
   const Vec3 axis = torus.axis.normalized();
@@ -305,27 +349,7 @@ nlohmann::json ring_measures(const TorusShape& torus, const Trajectory& t) {
     }
     prev = com;
   }
-  // Between frames, on the straight path of each particle: the simulation's contacts act only at steps,
-  // so a fast particle could pass through the tube unseen by the frames. Paths whose whole length is
-  // farther from the surface than their half length cannot come closer than that; the others are sampled
-  // at a spacing of a quarter of the tube's radius.
-  double min_between = min_phi;
-  const double spacing = 0.25 * torus.tube_radius;
-  for (int f = 0; f + 1 < t.frames(); ++f)
-    for (int i = 0; i < t.x[size_t(f)].size() / 3; ++i) {
-      const Vec3 a = seg(t.x[size_t(f)], i), b = seg(t.x[size_t(f) + 1], i);
-      double phi;
-      Vec3 n;
-      Mat3 dn;
-      ring.distance(0.5 * (a + b), phi, n, dn);
-      const double half = 0.5 * (b - a).norm();
-      if (phi - half >= min_between) continue;  // cannot lower the minimum
-      const int samples = 1 + int(std::ceil(2 * half / spacing));
-      for (int k = 0; k <= samples; ++k) {
-        ring.distance(a + (b - a) * (double(k) / samples), phi, n, dn);
-        min_between = std::min(min_between, phi);
-      }
-    }
+  const double min_between = min_distance_between_frames(ring, t, 0.25 * torus.tube_radius, min_phi);
   // Where the sheet ends, along the ring's axis from its plane, in the direction it crossed (positive: beyond).
   const Vec3 end_com = mean_of(t.x.back(), {});
   const double start_side = axis.dot(mean_of(t.x.front(), {}) - torus.center);

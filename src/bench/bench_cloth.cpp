@@ -2,9 +2,9 @@
 #include <functional>
 #include <iostream>
 
-#include "app/bench_point.h"
-#include "app/bench_sweeps.h"
-#include "app/plot.h"
+#include "bench/bench_point.h"
+#include "bench/bench_sweeps.h"
+#include "report/plot.h"
 #include "core/atomic_file.h"
 
 namespace kf {

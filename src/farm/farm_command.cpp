@@ -5,8 +5,8 @@
 
 #include "app/cli_ranges.h"
 #include "app/commands.h"
-#include "app/farm_render.h"
-#include "app/farm_sweep.h"
+#include "farm/farm_render.h"
+#include "farm/farm_sweep.h"
 #include "app/run_dir.h"
 #include "core/atomic_file.h"
 #include "core/error.h"

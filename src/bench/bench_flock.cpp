@@ -2,9 +2,9 @@
 #include <cmath>
 #include <iostream>
 
-#include "app/bench_point.h"
-#include "app/bench_sweeps.h"
-#include "app/plot.h"
+#include "bench/bench_point.h"
+#include "bench/bench_sweeps.h"
+#include "report/plot.h"
 #include "scene/flock_spec.h"
 
 namespace kf {

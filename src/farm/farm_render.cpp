@@ -1,4 +1,4 @@
-#include "app/farm_render.h"
+#include "farm/farm_render.h"
 
 #include <cstdio>
 

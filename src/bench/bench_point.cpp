@@ -1,4 +1,4 @@
-#include "app/bench_point.h"
+#include "bench/bench_point.h"
 
 #include <algorithm>
 #include <chrono>

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "app/slurm.h"
+#include "farm/slurm.h"
 #include "render/render_run.h"
 
 namespace kf::farm {

@@ -1,4 +1,4 @@
-#include "app/farm_sweep.h"
+#include "farm/farm_sweep.h"
 
 #include <cctype>
 #include <fstream>
@@ -7,7 +7,7 @@
 #include <set>
 #include <sstream>
 
-#include "app/plot.h"
+#include "report/plot.h"
 #include "app/run_dir.h"
 #include "farm/run_report.h"
 #include "core/atomic_file.h"

@@ -1,4 +1,4 @@
-#include "app/plot.h"
+#include "report/plot.h"
 
 #include <cstdio>
 #include <fstream>

@@ -1,4 +1,4 @@
-#include "app/slurm.h"
+#include "farm/slurm.h"
 
 #include <spawn.h>
 #include <sys/wait.h>

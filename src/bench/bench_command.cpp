@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <iostream>
 
-#include "app/bench_sweeps.h"
+#include "bench/bench_sweeps.h"
 #include "app/commands.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -25,8 +25,7 @@ struct BenchOptions {
   int point_steps = 0, point_every = 0, point_resolution = 16;
 };
 
-// The option groups of the four sweeps.
-void add_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
+void add_cloth_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
   auto* c = sub->add_option_group("cloth sweep");
   c->add_option("--substeps", o->cloth.substeps, "steps per 1/30 s frame (h = 1/(30 x substeps))")
       ->capture_default_str()->delimiter(',')->check(CLI::Range(1, 1000));
@@ -44,6 +43,9 @@ void add_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
       ->capture_default_str()->check(CLI::Range(0, 100000));
   c->add_option("--cloth-evaluations", o->cloth.optimize_evaluations, "L-BFGS evaluations per point")
       ->capture_default_str()->check(CLI::Range(0, 100000));
+}
+
+void add_flock_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
   auto* f = sub->add_option_group("flock sweep");
   f->add_option("--agents", o->flock.agents, "flock sizes")
       ->capture_default_str()->delimiter(',')->check(CLI::Range(2, 1000000));
@@ -51,6 +53,9 @@ void add_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
       ->capture_default_str()->check(CLI::Range(1, 100000));
   f->add_option("--flock-evaluations", o->flock.optimize_evaluations, "L-BFGS evaluations per point")
       ->capture_default_str()->check(CLI::Range(0, 100000));
+}
+
+void add_memory_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
   auto* m = sub->add_option_group("memory sweep");
   m->add_option("--steps", o->memory.steps, "step counts (cloth, 40 steps per frame)")
       ->capture_default_str()->delimiter(',')->check(CLI::Range(40, 10000000));
@@ -58,6 +63,9 @@ void add_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
       ->capture_default_str()->check(CLI::Range(1, 10000000));
   m->add_option("--memory-resolution", o->memory.resolution, "n of the n x n cloth")
       ->capture_default_str()->check(CLI::Range(2, 1024));
+}
+
+void add_solver_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
   auto* s = sub->add_option_group("solver sweep");
   s->add_option("--solver-resolutions", o->solver.resolutions, "n for n x n sheets")
       ->capture_default_str()->delimiter(',')->check(CLI::Range(2, 1024));
@@ -87,6 +95,9 @@ void add_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
                 "IC(0) PCG tolerances of our runs beside Blender's (each run's end state against a 1e-12 solve)")
       ->capture_default_str()->check(CLI::Range(1e-15, 1.0));
   s->add_option("--blender-script", o->solver.blender_script, "the anchor's Blender script")->capture_default_str();
+}
+
+void add_adjoint_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
   auto* a = sub->add_option_group("adjoint sweep");
   a->add_option("--adjoint-scenes", o->adjoint.scenes, "cloth scenes (names in --scene-dir) compared exact vs swap")
       ->capture_default_str()->delimiter(',');
@@ -95,6 +106,15 @@ void add_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
       ->capture_default_str()->check(CLI::Range(0, 100000));
   a->add_option("--adjoint-seconds", o->adjoint.optimize_seconds, "wall time of each optimisation")
       ->capture_default_str()->check(CLI::Range(0.1, 1e6));
+}
+
+// The option groups of the sweeps.
+void add_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
+  add_cloth_sweep_options(sub, o);
+  add_flock_sweep_options(sub, o);
+  add_memory_sweep_options(sub, o);
+  add_solver_sweep_options(sub, o);
+  add_adjoint_sweep_options(sub, o);
 }
 
 // --quick: smaller sweeps, except where an option was given explicitly.

@@ -5,9 +5,9 @@
 #include <iostream>
 #include <random>
 
-#include "app/bench_point.h"
-#include "app/bench_sweeps.h"
-#include "app/plot.h"
+#include "bench/bench_point.h"
+#include "bench/bench_sweeps.h"
+#include "report/plot.h"
 #include "core/error.h"
 #include "opt/gradcheck.h"
 #include "opt/problem.h"

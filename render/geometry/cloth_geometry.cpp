@@ -1,0 +1,96 @@
+#include <algorithm>
+#include <cmath>
+
+#include "core/check.h"
+#include "core/overloaded.h"
+#include "render/geometry/primitives.h"
+#include "render/geometry/system_geometry.h"
+
+namespace kf::render {
+
+namespace {
+
+// Each collider shape's drawing and the box it takes (a ground is drawn as the floor, ground_plane()).
+void add_collider(Mesh& m, const ColliderShape& shape, const Vec3& color) {
+  std::visit(Overloaded{
+                 [](const GroundShape&) {},
+                 [&](const SphereShape& s) { add_sphere(m, s.center, s.radius, color); },
+                 [&](const TorusShape& t) { add_torus(m, t.center, t.axis, t.radius, t.tube_radius, color); },
+                 [&](const CapsuleShape& c) { add_capsule(m, c.a, c.b, c.radius, color); },
+             },
+             shape);
+}
+
+}  // namespace
+
+void add_collider_bounds(const ColliderShape& shape, Bounds& b) {
+  std::visit(Overloaded{
+                 [](const GroundShape&) {},
+                 [&](const SphereShape& s) {
+                   b.add(s.center - Vec3::Constant(s.radius));
+                   b.add(s.center + Vec3::Constant(s.radius));
+                 },
+                 [&](const TorusShape& t) {
+                   b.add(t.center - Vec3::Constant(t.radius + t.tube_radius));
+                   b.add(t.center + Vec3::Constant(t.radius + t.tube_radius));
+                 },
+                 [&](const CapsuleShape& c) {
+                   b.add(c.a.cwiseMin(c.b) - Vec3::Constant(c.radius));
+                   b.add(c.a.cwiseMax(c.b) + Vec3::Constant(c.radius));
+                 },
+             },
+             shape);
+}
+
+void build_cloth(const Scene& scene, const Trajectory& traj, int f, double scale, FrameGeometry& g) {
+  const RenderSpec& rs = scene.render;
+  const int nx = scene.cloth->nx, ny = scene.cloth->ny;
+  CHECK_EQ(traj.particles, nx * ny);  // run directories are validated against their scene when read
+  const VecX& x = traj.x[f];
+  auto P = [&](int i, int j) -> Vec3 { return seg(x, j * nx + i); };
+  // Smooth normals from central differences of the grid.
+  std::vector<Vec3> normal(size_t(nx) * ny);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const Vec3 du = P(std::min(i + 1, nx - 1), j) - P(std::max(i - 1, 0), j);
+      const Vec3 dv = P(i, std::min(j + 1, ny - 1)) - P(i, std::max(j - 1, 0));
+      const Vec3 c = du.cross(dv);
+      normal[size_t(j) * nx + i] = c.norm() > 1e-15 ? c.normalized() : Vec3::UnitY();
+    }
+  const int squares = rs.checker;
+  Mesh& m = g.objects;
+  for (int j = 0; j + 1 < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {
+      bool odd = false;
+      if (squares > 0) {
+        const int si = (i * squares) / (nx - 1), sj = (j * squares) / (ny - 1);
+        odd = ((si + sj) & 1) != 0;
+      }
+      const Vec3 front = odd ? rs.cloth_front * 0.72 : rs.cloth_front;
+      const Vec3 back = odd ? rs.cloth_back * 0.8 : rs.cloth_back;
+      const uint32_t base = uint32_t(m.vertices.size());
+      const int ci[4] = {i, i + 1, i + 1, i}, cj[4] = {j, j, j + 1, j + 1};
+      for (int k = 0; k < 4; ++k)
+        add_vertex(m, P(ci[k], cj[k]), normal[size_t(cj[k]) * nx + ci[k]], front, back);
+      m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    }
+  for (const auto& c : scene.cloth->colliders) add_collider(m, c.shape, rs.collider_color);
+  // Targets of the keyframes still to come, small beside their own spacing so a sheet of targets does
+  // not hide the cloth that reaches it. A blend's end target (a whole other take's cape) is drawn at its
+  // own frame only: over the cape in every frame it would hide the blend.
+  size_t markers = 0;
+  for (const auto& o : scene.objectives) {
+    const auto* position = std::get_if<PositionKeyframe>(&o.kind);
+    if (!position || o.frame < f || position->targets.empty()) continue;
+    if (o.source == ObjectiveSource::kEndTarget && o.frame != f) continue;
+    const std::vector<Vec3>& targets = position->targets;
+    Bounds tb;
+    for (const Vec3& q : targets) tb.add(q);
+    const double spacing = 2 * tb.radius() / std::sqrt(double(targets.size()));
+    const double size = targets.size() > 1 ? std::min(0.012 * scale, 0.2 * spacing) : 0.012 * scale;
+    for (const Vec3& q : targets)
+      if (markers++ < 4096) add_marker(m, q, size, rs.target_color);
+  }
+}
+
+}  // namespace kf::render
