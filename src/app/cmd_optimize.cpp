@@ -30,11 +30,18 @@ void exit_if_interrupted(const OptimizeOutcome& r) {
   if (r.interrupted) std::exit(kExitInterrupted);
 }
 
+void exit_if_failed(const OptimizeOutcome& r) {
+  if (!r.failed) return;
+  std::cerr << "keyframe: " << r.diagnosis << " (run directory " << r.dir.string() << ")\n";
+  std::exit(kExitNotReached);
+}
+
 void add_optimize_command(CLI::App& app) {
   auto* sub = app.add_subcommand("optimize",
                                  "find the control forces that make the simulation hit the scene's keyframes "
                                  "(adjoint gradient + L-BFGS); writes trajectory.bin, controls.bin, "
-                                 "iterations.csv, convergence.png, report.json");
+                                 "iterations.csv, convergence.png, report.json; exits with 7 and says why when "
+                                 "the keyframes were not reached");
   auto scene = std::make_shared<std::string>();
   auto opts = std::make_shared<OptimizeOptions>();
   sub->add_option("SCENE", *scene, "scene file (JSON); not needed with --resume");
@@ -43,7 +50,9 @@ void add_optimize_command(CLI::App& app) {
                   "continue an interrupted run from RUN_DIR/controls.bin (writes into RUN_DIR)");
   sub->callback([=] {
     if (scene->empty() && opts->resume.empty()) throw CLI::RequiredError("SCENE");
-    exit_if_interrupted(optimize_job(*scene, *opts));
+    const OptimizeOutcome outcome = optimize_job(*scene, *opts);
+    exit_if_interrupted(outcome);
+    exit_if_failed(outcome);
   });
 }
 

@@ -32,6 +32,7 @@ void add_run_command(CLI::App& app) {
     r.run_dir = dir;
     const int n = render::render_run(r);
     std::cout << "rendered " << n << " frames into " << (dir / "frames").string() << "\n";
+    exit_if_failed(outcome);  // rendered all the same: the frames show what went wrong
   });
 }
 

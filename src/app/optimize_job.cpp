@@ -1,6 +1,8 @@
 #include "app/optimize_job.h"
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <iomanip>
 #include <iostream>
@@ -16,6 +18,7 @@
 #include "core/progress.h"
 #include "core/trajectory.h"
 #include "opt/controls_file.h"
+#include "opt/diagnosis.h"
 #include "report/figure_measures.h"
 #include "opt/optimizer.h"
 #include "sim/make_system.h"
@@ -139,6 +142,49 @@ OptimizeResult run_stage(Problem& problem, OptimizerSpec spec, int restarts, con
   return res;
 }
 
+// One stage as report.json's stage_results states it.
+struct StageResult {
+  std::string kind;  // its controls' kind
+  int substeps = 0, evaluations = 0;
+  double objective_start = 0, objective_end = 0;
+  std::string status;
+  nlohmann::json to_json() const {
+    return {{"kind", kind},
+            {"substeps", substeps},
+            {"evaluations", evaluations},
+            {"objective_start", objective_start},
+            {"objective_end", objective_end},
+            {"status", status}};
+  }
+};
+
+// The keyframe terms of an evaluation's breakdown (φ without the effort term).
+double keyframe_terms(const std::vector<std::pair<std::string, double>>& terms) {
+  double sum = 0;
+  for (const auto& [name, value] : terms)
+    if (name != "effort") sum += value;
+  return sum;
+}
+
+// What the run shows besides its keyframes: its budget, its largest trial objective, how fast it still fell.
+RunFacts run_facts(const std::string& status, const std::vector<HistoryRow>& history) {
+  RunFacts f;
+  f.status = status;
+  f.budget = status.find("limit reached") != std::string::npos;
+  if (history.empty()) return f;
+  f.objective_start = history.front().rec.phi;
+  f.evaluations = int(history.size());
+  double best = INFINITY, best_earlier = INFINITY;
+  const size_t earlier = history.size() - std::max<size_t>(1, history.size() / 10);
+  for (size_t i = 0; i < history.size(); ++i) {
+    f.max_objective = std::max(f.max_objective, history[i].rec.phi);
+    best = std::min(best, history[i].rec.phi);
+    if (i < earlier) best_earlier = std::min(best_earlier, history[i].rec.phi);
+  }
+  f.recent_improvement = std::isfinite(best_earlier) && best_earlier > 0 ? best / best_earlier : 1.0;
+  return f;
+}
+
 // What the stages leave behind.
 struct JobResult {
   EvaluationTape tape;  // every evaluation, for a resume that continues exactly where this run stopped
@@ -150,6 +196,8 @@ struct JobResult {
   bool interrupted = false;
   int evaluations = 0;
   double seconds = 0;
+  std::vector<StageResult> stages;
+  Diagnosis diagnosis;
 };
 
 // Simulates the best point (and, for a cape blend, the uncontrolled run its end state is measured
@@ -159,13 +207,15 @@ nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, size_t 
                                 JobResult& job, const EvaluationLog& elog) {
   Problem& problem = *job.problem;
   System& sys = *job.sys;
+  // The uncontrolled run (the initial guess: no force, the scene's own initial velocities): the keyframes'
+  // errors before, and for a cape blend the end state it is measured against.
   nlohmann::json uncontrolled_stats;
-  Trajectory uncontrolled;
-  if (scene.character) {
-    problem.evaluate(problem.initial_guess(), nullptr);
-    uncontrolled = frames_of(problem.rollout(), job.time, sys.particles());
-    for (const auto& [name, value] : sys.run_stats()) uncontrolled_stats[name] = value;
-  }
+  const double uncontrolled_objective = problem.evaluate(problem.initial_guess(), nullptr);
+  const bool uncontrolled_diverged = problem.last_diverged();
+  const double uncontrolled_keyframes = uncontrolled_diverged ? uncontrolled_objective : keyframe_terms(problem.breakdown());
+  const Trajectory uncontrolled = frames_of(problem.rollout(), job.time, sys.particles());
+  for (const auto& [name, value] : sys.run_stats()) uncontrolled_stats[name] = value;
+  const nlohmann::json measures_before = figure_measures(scene, uncontrolled);
   const double final_objective = problem.evaluate(job.z, nullptr);
   const Trajectory frames = frames_of(problem.rollout(), job.time, sys.particles());
   save_controls(dir / "controls.bin", job.z, job.time.substeps);
@@ -201,6 +251,29 @@ nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, size_t 
   nlohmann::json terms = nlohmann::json::object();
   for (const auto& [name, value] : problem.breakdown()) terms[name] = value;
   report["final_terms"] = terms;
+  double effort_end = 0;
+  for (const auto& [name, value] : problem.breakdown())
+    if (name == "effort") effort_end = value;
+  const double final_keyframes = problem.last_diverged() ? final_objective : keyframe_terms(problem.breakdown());
+
+  // Whether the keyframes were reached and, if not, why (opt/diagnosis.h).
+  const std::vector<KeyframeJudgement> keyframes = judge_keyframes(scene, measures_before, report["measures"]);
+  const Sensitivity sensitivity = measure_sensitivity(scene, job.time);
+  RunFacts facts = run_facts(job.status, elog.history());
+  facts.keyframe_objective_start = uncontrolled_keyframes;
+  facts.keyframe_objective_end = final_keyframes;
+  facts.effort_end = effort_end;
+  job.diagnosis = diagnose(keyframes, sensitivity, facts);
+  report["diagnosis"] = job.diagnosis.to_json();
+  report["diagnosis"]["keyframe_objective_start"] = uncontrolled_keyframes;
+  report["diagnosis"]["keyframe_objective_end"] = final_keyframes;
+  report["diagnosis"]["budget_reached"] = facts.budget;
+  report["diagnosis"]["max_objective_evaluated"] = facts.max_objective;
+  report["keyframe_errors"] = nlohmann::json::array();
+  for (const auto& k : keyframes) report["keyframe_errors"].push_back(k.to_json());
+  report["sensitivity"] = sensitivity.to_json();
+  report["stage_results"] = nlohmann::json::array();
+  for (const auto& st : job.stages) report["stage_results"].push_back(st.to_json());
   for (const auto& [name, value] : sys.run_stats()) report["run_stats"][name] = value;
   if (scene.character) {
     report["uncontrolled_run_stats"] = uncontrolled_stats;
@@ -216,6 +289,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   const bool resuming = !opt.resume.empty();
   Scene scene = resuming ? load_run_scene(opt.resume) : load_scene(scene_file);
   if (!opt.adjoint.empty()) scene.optimizer.adjoint = opt.adjoint;
+  if (opt.max_seconds >= 0) scene.optimizer.max_seconds = opt.max_seconds;
   const fs::path dir = resuming ? fs::path(opt.resume) : run_dir_for(scene, opt.out);
 
   // The stages of coarse-to-fine continuation; a resumed run continues in the last stage.
@@ -289,6 +363,14 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
                                          job.seconds, elog, progress, job.tape);
     progress.finish();
     z = res.z;
+    StageResult st;
+    st.kind = problem.controls().kind();
+    st.substeps = time.substeps;
+    st.evaluations = res.evaluations;
+    st.objective_start = res.history.empty() ? res.phi : res.history.front().phi;
+    st.objective_end = res.phi;
+    st.status = res.status;
+    job.stages.push_back(st);
     job.seconds += res.seconds;
     job.evaluations += res.evaluations;
     job.status = res.status;
@@ -304,8 +386,13 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (opt.quiet) std::cout << tail.str() << std::endl;
   if (job.interrupted)
     elog.say("interrupted: best controls so far saved; continue with: keyframe optimize --resume " + dir.string());
-  commit_run_dir(staged, [&](const fs::path& w) { write_file_atomic(w / (resuming ? "log_resumed.txt" : "log.txt"), elog.text()); });
-  return {dir, job.interrupted};
+  else
+    elog.say(job.diagnosis.line);
+  if (opt.quiet && !job.interrupted && !job.diagnosis.failed()) std::cout << job.diagnosis.line << std::endl;
+  commit_run_dir(staged, [&](const fs::path& w) {
+    write_file_atomic(w / (resuming ? "log_resumed.txt" : "log.txt"), elog.text());
+  });
+  return {dir, job.interrupted, !job.interrupted && job.diagnosis.failed(), job.diagnosis.line};
 }
 
 }  // namespace kf

@@ -17,11 +17,14 @@ struct OptimizeOptions {
   int checkpoint_every = -1;  // override the scene's optimizer.checkpoint_every when >= 0
   std::string adjoint;        // override the scene's optimizer.adjoint when not empty ("exact" | "swap")
   std::string max_memory;     // refuse a run estimated to need more ("4G"); "" = the machine's memory
+  double max_seconds = -1;    // override the scene's optimizer.max_seconds (per stage) when >= 0
 };
 
 struct OptimizeOutcome {
   std::filesystem::path dir;
   bool interrupted = false;
+  bool failed = false;    // the keyframes were not reached (opt/diagnosis.h); the run directory is written
+  std::string diagnosis;  // one line: what happened, its cause and what to change
 };
 
 // Throws InputError/OutputError. On SIGINT/SIGTERM it saves the best controls so far, writes the run
@@ -32,5 +35,10 @@ OptimizeOutcome optimize_job(const std::filesystem::path& scene_file, const Opti
 void add_optimize_options(CLI::App* sub, OptimizeOptions& o);
 // Exits with kExitInterrupted when the job was stopped by a signal (after it saved its run directory).
 void exit_if_interrupted(const OptimizeOutcome& r);
+// Exit code of optimize and run when the keyframes were not reached (no progress, or far from a target); the
+// run directory is written and report.json says why. Beside the others in core/error.h (README.md lists all).
+constexpr int kExitNotReached = 7;
+// Prints the diagnosis and exits with kExitNotReached when the keyframes were not reached.
+void exit_if_failed(const OptimizeOutcome& r);
 
 }  // namespace kf

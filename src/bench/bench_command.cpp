@@ -22,6 +22,7 @@ struct BenchOptions {
   MemorySweepOptions memory;
   SolverSweepOptions solver;
   AdjointSweepOptions adjoint;
+  RobustnessSweepOptions robustness;
   int point_steps = 0, point_every = 0, point_resolution = 16;
 };
 
@@ -106,6 +107,18 @@ void add_adjoint_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions
       ->capture_default_str()->check(CLI::Range(0, 100000));
   a->add_option("--adjoint-seconds", o->adjoint.optimize_seconds, "wall time of each optimisation")
       ->capture_default_str()->check(CLI::Range(0.1, 1e6));
+  auto* r = sub->add_option_group("robustness suite");
+  r->add_option("--robustness-dir", o->robustness.scene_dir, "the suite's scenes")->capture_default_str();
+  r->add_option("--robustness-runs", o->robustness.runs_dir, "where each scene's run directory goes")
+      ->capture_default_str();
+  r->add_option("--robustness-scenes", o->robustness.scenes, "only these scenes (names in --robustness-dir)")
+      ->delimiter(',');
+  r->add_option("--robustness-evaluations", o->robustness.max_evaluations,
+                "override every scene's evaluation budget (-1: the scene's own)")
+      ->capture_default_str()->check(CLI::Range(-1, 1000000));
+  r->add_option("--robustness-seconds", o->robustness.max_seconds,
+                "wall-time limit of each scene's optimiser (0: the scene's own); a scene passes only within it")
+      ->capture_default_str()->check(CLI::Range(0.0, 1e6));
 }
 
 // The option groups of the sweeps.
@@ -144,14 +157,16 @@ void add_bench_command(CLI::App& app) {
       "flock (agents, fitted scaling exponent), memory (peak RSS against steps with and without adjoint "
       "checkpointing), adjoint (exact against swap on the cloth figures: gradient cost and error, keyframe error "
       "in the same wall time), solver (cloth step cost against particles per linear solver and thread count, "
-      "forward and gradient, beside Blender when installed); writes CSV + PNG under --out");
+      "forward and gradient, beside Blender when installed), robustness (only when named in --only: the scenes of "
+      "scenes/robustness optimised at their default settings and judged by their keyframes); writes CSV + PNG "
+      "under --out");
   auto o = std::make_shared<BenchOptions>();
   sub->add_option("--out", o->out, "output directory")->capture_default_str();
   sub->add_flag("--quick", o->quick,
                 "reduced sweep (a few minutes): substeps 1,4,16; n 16,24,32; tolerances 1e-4,1e-6,1e-8; agents "
                 "100,300,1000; steps 500..4000; fewer samples and evaluations. Options given explicitly win.");
   sub->add_option("--only", o->only, "run only these sweeps")
-      ->check(CLI::IsMember({"cloth", "flock", "memory", "adjoint", "solver"}))
+      ->check(CLI::IsMember({"cloth", "flock", "memory", "adjoint", "solver", "robustness"}))
       ->delimiter(',');
   add_sweep_options(sub, o);
   // The child side of the memory sweep: one gradient in a fresh process.
@@ -175,6 +190,9 @@ void add_bench_command(CLI::App& app) {
     if (want("cloth")) summary["cloth"] = bench_cloth(o->cloth, out);
     if (want("adjoint")) summary["adjoint"] = bench_adjoint(o->adjoint, out);
     if (want("solver")) summary["solver"] = bench_solver(o->solver, out);
+    // The suite takes up to an hour: only when named.
+    if (std::find(o->only.begin(), o->only.end(), "robustness") != o->only.end())
+      summary["robustness"] = bench_robustness(o->robustness, out);
     write_file_atomic(out / "summary.json", summary.dump(2) + "\n");
   });
 }

@@ -53,6 +53,20 @@ struct AdjointSweepOptions {
   int samples = 16;               // finite-difference coordinates per gradient check
 };
 
+struct RobustnessSweepOptions {
+  std::filesystem::path scene_dir = "scenes/robustness";
+  std::vector<std::string> scenes;  // names in scene_dir; empty: every scene there
+  std::filesystem::path runs_dir = "out/robustness";  // each scene's run directory goes here
+  int max_evaluations = -1;         // >= 0: overrides each scene's budget (a reduced run)
+  double max_seconds = 180;         // each scene's optimiser stops after this wall time (0: the scene's own)
+  double pass_seconds = 180;        // a scene passes only within this wall time (the whole job)
+};
+
+// Robustness: each scene optimised at its own (default) settings and judged by its keyframes
+// (robustness.csv: scene, strategy, the worst keyframe's error before and after, evaluations, seconds, pass;
+// robustness.png; each run's report.json as reports/<scene>.json; the run directories under runs_dir).
+nlohmann::json bench_robustness(const RobustnessSweepOptions& o, const std::filesystem::path& out);
+
 // Adjoint: exact against swap on the cloth figures (adjoint.csv): gradient cost and error, and the
 // keyframe error reached in the same wall time. Scenes that cannot load (a cape blend whose clips were not
 // simulated) are skipped with a message.

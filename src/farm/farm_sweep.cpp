@@ -202,9 +202,11 @@ SweepPlan plan_sweep_farm(const SweepFarm& farm) {
   s += "runs=(" + runs + ")\n";
   s += "run=${runs[$SLURM_ARRAY_TASK_ID]}\n";
   s += "cd " + out + "\n";
-  s += "exec \"$keyframe\" --threads \"${SLURM_CPUS_PER_TASK:-0}\" optimize \"scenes/$run.json\" --out \"$run\" "
+  // Exit 7 (the keyframes were not reached) is a finished run of the sweep: its report says why.
+  s += "\"$keyframe\" --threads \"${SLURM_CPUS_PER_TASK:-0}\" optimize \"scenes/$run.json\" --out \"$run\" "
        "--quiet" +
-       (farm.max_evaluations >= 0 ? " --max-evaluations " + std::to_string(farm.max_evaluations) : "") + "\n";
+       (farm.max_evaluations >= 0 ? " --max-evaluations " + std::to_string(farm.max_evaluations) : "") +
+       " || [ $? -eq 7 ]\n";
   plan.optimize_script = s;
 
   s = "#!/bin/bash\n";

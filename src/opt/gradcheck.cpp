@@ -35,8 +35,8 @@ std::vector<int> pick_coordinates(const VecX& g, int samples, unsigned seed) {
   return picks;
 }
 
-// The round-off σ of φ near z: φ along a random direction at steps so small that φ is linear there; its
-// second differences are then round-off alone (each has variance 6σ²).
+}  // namespace
+
 double phi_noise(Problem& problem, const VecX& z, double phi, unsigned seed) {
   std::mt19937_64 rng(seed + 1);
   std::normal_distribution<double> normal;
@@ -50,8 +50,6 @@ double phi_noise(Problem& problem, const VecX& z, double phi, unsigned seed) {
   // At least φ's own rounding: a φ that is linear to the last bit there still quantises differences.
   return std::max(std::sqrt(sum / 5 / 6), std::numeric_limits<double>::epsilon() * std::abs(phi));
 }
-
-}  // namespace
 
 DifferenceEstimate extrapolated_difference(double step, const std::function<double(double)>& central,
                                            double target, double noise) {

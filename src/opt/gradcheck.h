@@ -55,4 +55,9 @@ DifferenceEstimate extrapolated_difference(double step, const std::function<doub
 
 GradcheckResult gradcheck(Problem& problem, const VecX& z, const GradcheckOptions& options);
 
+// The round-off σ of φ near z (φ = φ(z), already evaluated): φ along a random direction (from `seed`) at steps
+// of 1e-9 max(1, |z|∞), so small that φ is linear there; its second differences are then round-off alone
+// (each has variance 6σ²). Where φ is no function of z at that scale (a bifurcation) it is φ's jitter.
+double phi_noise(Problem& problem, const VecX& z, double phi, unsigned seed);
+
 }  // namespace kf

@@ -132,6 +132,8 @@ ClothSpec parse_cloth_spec(Block& b) {
   s.air_drag = b.number("air_drag", s.air_drag, 0.0, 1e6);
   s.gravity = b.vec3("gravity", s.gravity, -1e4, 1e4);
   s.velocity = b.vec3("velocity", s.velocity, -1e4, 1e4);
+  s.imperfection = b.number("imperfection", s.imperfection, 0.0, 0.01);
+  s.imperfection_seed = b.integer("imperfection_seed", s.imperfection_seed, 0, 1'000'000'000);
   s.cg_tolerance_stated = b.has("cg_tolerance");
   s.cg_tolerance = b.number("cg_tolerance", s.cg_tolerance, 1e-16, 1e-1);
   s.cg_max_iterations = b.integer("cg_max_iterations", s.cg_max_iterations, 1, 1'000'000);

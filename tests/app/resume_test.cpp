@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "app/optimize_job.h"
 #include "core/error.h"
 
 namespace kf {
@@ -67,7 +68,9 @@ TEST(Resume, InterruptedThenResumedRunMatchesAnUninterruptedOne) {
   fs::create_directories(dir);
   std::ofstream(dir / "small.json") << kScene;
 
-  ASSERT_EQ(run_keyframe(dir, {"optimize", "small.json", "--out", "whole"}), 0);
+  // The flock converges short of its keyframes (exit 7, kExitNotReached); what is compared is the objective.
+  const int whole_code = run_keyframe(dir, {"optimize", "small.json", "--out", "whole"});
+  ASSERT_TRUE(whole_code == 0 || whole_code == kExitNotReached) << whole_code;
   const double whole = final_objective(dir / "whole");
 
   EXPECT_EQ(run_keyframe(dir, {"optimize", "small.json", "--out", "cut"}, 3), kExitInterrupted);
@@ -77,7 +80,7 @@ TEST(Resume, InterruptedThenResumedRunMatchesAnUninterruptedOne) {
   const double at_cut = j.at("final_objective").get<double>();
   EXPECT_GT(at_cut, whole * 1.01) << "the interrupted run had already converged; interrupt earlier";
 
-  ASSERT_EQ(run_keyframe(dir, {"optimize", "--resume", "cut"}), 0);
+  EXPECT_EQ(run_keyframe(dir, {"optimize", "--resume", "cut"}), whole_code);
   const double resumed = final_objective(dir / "cut");
   EXPECT_LT(resumed, at_cut);
   EXPECT_NEAR(resumed, whole, 1e-3 * whole + 1e-9) << "uninterrupted " << whole << ", resumed " << resumed;

@@ -1,6 +1,8 @@
 // The thread count changes speed only: optimising and rendering a scene with one worker thread and with
 // two gives byte-identical trajectories, controls and frames.
 #include "cli_harness.h"
+#include "app/optimize_job.h"
+#include "core/error.h"
 
 namespace kf::reliability {
 namespace {
@@ -12,7 +14,8 @@ class Determinism : public TempDirTest {
                            const std::string& backend) {
     const std::string t = "--threads " + std::to_string(threads) + " ";
     CliResult r = run_keyframe(t + "optimize " + scene + " --quiet --out " + out, dir_);
-    ASSERT_EQ(r.code, 0) << r.output;
+    // These few evaluations do not reach the keyframes (exit 7); the bits are what is compared.
+    ASSERT_TRUE(r.code == 0 || r.code == kExitNotReached) << r.output;
     r = run_keyframe(t + "render " + out + " --backend " + backend + " --frames 0:3 --size 48x32", dir_);
     ASSERT_EQ(r.code, 0) << r.output;
   }

@@ -119,7 +119,8 @@ class KillSafety : public TempDirTest {
     const pid_t pid = spawn_keyframe(dir_, {"run", "f.json", "--quiet", "--out", "full"});
     int status = 0;
     ::waitpid(pid, &status, 0);
-    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    // 20 evaluations do not reach the keyframe (exit 7, kExitNotReached); the run is rendered all the same.
+    EXPECT_TRUE(WIFEXITED(status) && (WEXITSTATUS(status) == 0 || WEXITSTATUS(status) == 7)) << status;
     return std::chrono::duration<double>(Clock::now() - t0).count();
   }
 };

@@ -76,5 +76,42 @@ TEST(ClothSpec, CollidersAndErrorsNameTheirPlace) {
             std::string::npos);
 }
 
+TEST(ClothSpec, ImperfectionIsSeededSubMillimetreAndValidated) {
+  const ClothSpec c = *scene_with(R"({"nx": 4, "ny": 4, "imperfection": 5e-4, "imperfection_seed": 3})").cloth;
+  EXPECT_EQ(c.imperfection, 5e-4);
+  EXPECT_EQ(c.imperfection_seed, 3);
+  EXPECT_EQ(scene_with(R"({"nx": 4, "ny": 4})").cloth->imperfection, 0.0);
+  const std::string e = error_of(R"({"imperfection": 0.5})");
+  EXPECT_NE(e.find("c.json"), std::string::npos) << e;
+  EXPECT_NE(e.find("/cloth/imperfection"), std::string::npos) << e;
+  EXPECT_NE(error_of(R"({"imperfection": -1e-4})").find("/cloth/imperfection"), std::string::npos);
+  EXPECT_NE(error_of(R"({"imperfection_seed": -1})").find("/cloth/imperfection_seed"), std::string::npos);
+  // The imperfection moves particles off the plane only, by at most its amplitude, the same for one seed.
+  ClothSystem flat(*scene_with(R"({"nx": 5, "ny": 4, "v_axis": [0, 0, 1]})").cloth, 1.0 / 30);
+  const ClothSpec bumpy = *scene_with(R"({"nx": 5, "ny": 4, "v_axis": [0, 0, 1], "imperfection": 5e-4})").cloth;
+  ClothSystem a(bumpy, 1.0 / 30), b(bumpy, 1.0 / 30);
+  VecX x0, v0, xa, va, xb, vb;
+  flat.initial_state(x0, v0);
+  a.initial_state(xa, va);
+  b.initial_state(xb, vb);
+  EXPECT_EQ(xa, xb);
+  double largest = 0;
+  for (int i = 0; i < 20; ++i) {
+    const Vec3 d = seg(xa, i) - seg(x0, i);
+    EXPECT_EQ(d.x(), 0.0);
+    EXPECT_EQ(d.z(), 0.0);
+    EXPECT_LE(std::abs(d.y()), 5e-4);
+    largest = std::max(largest, std::abs(d.y()));
+  }
+  EXPECT_GT(largest, 2e-4);
+  // Another seed, other draws; the springs rest in the moved shape, so it starts at rest.
+  ClothSystem other(*scene_with(R"({"nx": 5, "ny": 4, "v_axis": [0, 0, 1], "imperfection": 5e-4, "imperfection_seed": 2})").cloth,
+                    1.0 / 30);
+  VecX xo, vo;
+  other.initial_state(xo, vo);
+  EXPECT_NE(xo, xa);
+  EXPECT_NEAR(a.state_energy(xa, va).elastic, 0.0, 1e-15);
+}
+
 }  // namespace
 }  // namespace kf

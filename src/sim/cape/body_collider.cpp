@@ -56,6 +56,79 @@ bool BodyCollider::contact(int, const Vec3& x, const Vec3&, bool definite, Conta
   return true;
 }
 
+bool BodyCollider::friction(int, const Vec3& x, const Vec3& v, bool exact, ContactForce& out) const {
+  BodyHit hit;
+  Mat3 dn;
+  if (!friction_.on() || !query(x, hit, dn)) return false;
+  const Vec3& n = hit.normal;
+  double g, dg, ddg;
+  profile_.eval(thickness_ - hit.signed_distance, g, dg, ddg);
+  Vec3 vb;
+  Mat3 dvb;
+  surface_velocity(hit, vb, dvb);
+  // Limit mu g(thickness - phi), dL/dx = -mu g' n; slip u = v - vb(x).
+  const FrictionForce fr = friction_force(friction_.mu * g, n, v - vb, friction_.eps);
+  out.f = fr.f;
+  out.dfdv = fr.dfdu;
+  out.dfdx.setZero();
+  if (exact) {
+    out.dfdx = fr.dfdL * (-friction_.mu * dg * n).transpose() - fr.dfdu * dvb;
+    if (curvature_) out.dfdx += fr.dfdn * dn;
+  }
+  return true;
+}
+
+void BodyCollider::surface_velocity(const BodyHit& hit, Vec3& velocity, Mat3& dvelocity_dx) const {
+  velocity.setZero();
+  dvelocity_dx.setZero();
+  if (velocity_.size() == 0) return;
+  const auto& surface = query_.surface();
+  const VecX& x = surface.vertices();
+  int id[3];
+  for (int k = 0; k < 3; ++k) id[k] = surface.triangles()(hit.triangle, k);
+  for (int k = 0; k < 3; ++k) velocity += hit.barycentric[k] * seg(velocity_, id[k]);
+  int a = -1, b = -1;
+  switch (hit.feature) {
+    case TriangleFeature::kFace: {
+      // The closest point is x projected on the face's plane: its barycentrics (beta, gamma) along
+      // e1 = B - A, e2 = C - A change by (E^T E)^-1 E^T dx.
+      Eigen::Matrix<double, 3, 2> E, V;
+      for (int k = 0; k < 2; ++k) {
+        E.col(k) = seg(x, id[k + 1]) - seg(x, id[0]);
+        V.col(k) = seg(velocity_, id[k + 1]) - seg(velocity_, id[0]);
+      }
+      dvelocity_dx = V * (E.transpose() * E).inverse() * E.transpose();
+      return;
+    }
+    case TriangleFeature::kEdgeAB: a = 0, b = 1; break;
+    case TriangleFeature::kEdgeBC: a = 1, b = 2; break;
+    case TriangleFeature::kEdgeCA: a = 2, b = 0; break;
+    default: return;  // at a vertex the closest point stays put
+  }
+  // On an edge the closest point slides along it by e e^T dx / |e|^2.
+  const Vec3 e = seg(x, id[b]) - seg(x, id[a]);
+  dvelocity_dx = (seg(velocity_, id[b]) - seg(velocity_, id[a])) * e.transpose() / e.squaredNorm();
+}
+
+void BodyCollider::damping_derivative(int, const Vec3& x, const Vec3& v, const Vec3& w, const Vec3& c, Vec3& ddx,
+                                      Vec3& ddv) const {
+  ddx.setZero();
+  ddv.setZero();
+  BodyHit hit;
+  Mat3 dn;
+  if (!friction_.on() || !query(x, hit, dn)) return;
+  const Vec3& n = hit.normal;
+  double g, dg, ddg;
+  profile_.eval(thickness_ - hit.signed_distance, g, dg, ddg);
+  Vec3 vb;
+  Mat3 dvb;
+  surface_velocity(hit, vb, dvb);
+  const FrictionDampingDerivative d = friction_damping_derivative(friction_.mu * g, n, v - vb, friction_.eps, w, c);
+  ddx = d.dL * (-friction_.mu * dg * n) - dvb.transpose() * d.du;
+  if (curvature_) ddx += dn * d.dn;  // dn is symmetric
+  ddv = d.du;
+}
+
 Vec3 BodyCollider::definite_stiffness_derivative(int, const Vec3& x, const Vec3& w, const Vec3& c) const {
   BodyHit hit;
   Mat3 dn;

@@ -4,6 +4,11 @@
 // `thickness`.
 //
 // The pose is set from outside once per step (set_pose refits the BVH), so contact() only reads.
+//
+// Friction (Collider::set_friction) acts against the particle's velocity relative to the body's surface at
+// the closest point: the barycentric blend of the vertex velocities set_velocity gives (a still body
+// without them). The blend moves with x (the closest point slides on a face or an edge), so the exact
+// df/dx holds its derivative too.
 #include <atomic>
 #include <limits>
 
@@ -22,12 +27,17 @@ class BodyCollider final : public Collider {
 
   // New body pose: 3n vertex positions, metres, world frame. Allocation-free after the first call.
   void set_pose(const VecX& vertices) { query_.update(vertices); }
+  // Body vertex velocities (3n, m/s) of the step, for friction; empty: a still body.
+  void set_velocity(const VecX& velocities) { velocity_ = velocities; }
 
   // f = g n; df/dx = -g' n n^T, plus g dn/dx when `definite` is false and the curvature term is on
   // (dn/dx is zero on a face, sign (I - n n^T) / distance at a vertex and sign (I - n n^T - t t^T) /
   // distance on an edge with tangent t). df/dv = 0.
   bool contact(int n, const Vec3& x, const Vec3& v, bool definite, ContactForce& out) const override;
   Vec3 definite_stiffness_derivative(int n, const Vec3& x, const Vec3& w, const Vec3& c) const override;
+  bool friction(int n, const Vec3& x, const Vec3& v, bool exact, ContactForce& out) const override;
+  void damping_derivative(int n, const Vec3& x, const Vec3& v, const Vec3& w, const Vec3& c, Vec3& ddx,
+                          Vec3& ddv) const override;
 
   // The curvature term of the exact df/dx (on by default; the exact adjoint needs it). The swap adjoint
   // turns it off: explicit in that adjoint's K^T w and growing as 1/distance near the mesh's edges, it was
@@ -46,11 +56,14 @@ class BodyCollider final : public Collider {
  private:
   // The closest body point to x and dn/dx there; false when x is not in contact.
   bool query(const Vec3& x, BodyHit& hit, Mat3& dn) const;
+  // The body's velocity at the hit's closest point (m/s) and its derivative in the query point (1/s).
+  void surface_velocity(const BodyHit& hit, Vec3& velocity, Mat3& dvelocity_dx) const;
 
   BodyQuery query_;
   double thickness_;
   ContactProfile profile_;
   double search_;
+  VecX velocity_;
   bool curvature_ = true;
   bool counting_ = false;
   mutable std::atomic<int> count_{0};

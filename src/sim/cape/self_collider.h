@@ -6,6 +6,10 @@
 // gives d f_i / d x_i. The cross blocks d f_i / d x_j (= -d f_i / d x_i of that pair) cannot go through
 // that interface; the cloth's implicit matrix A leaves them out (like a block-Jacobi stiffness), and
 // add_cross_transpose puts them into the adjoints' Kx^T w so xhat uses the exact Jacobian.
+//
+// Friction (Collider::set_friction) acts on each pair against the relative velocity u = v_i - v_j, with limit
+// mu g(thickness - r) and normal n = d / r. Its velocity coupling is the same gather: d f_i / d v_i in the
+// implicit matrix, the cross block d f_i / d v_j = -(that) through add_friction_coupled.
 #include <atomic>
 #include <cstdint>
 #include <utility>
@@ -20,8 +24,10 @@ class SelfCollider final : public Collider {
   // particles: p; thickness, ramp: metres; stiffness: N/m.
   SelfCollider(int particles, double thickness, double stiffness, double ramp);
 
-  // Positions of the state the next contact() calls see (3p, metres). Allocation-free.
+  // Positions (3p, metres) and velocities (3p, m/s; friction reads them) of the state the next contact()
+  // calls see. Allocation-free. Without velocities every particle counts as still.
   void update(const VecX& x);
+  void update(const VecX& x, const VecX& v);
 
   // Sums the pairs of the particle at x (it must be one of the updated positions; the particle itself is
   // recognised by its identical position). df/dx: per pair -g' n n^T, plus g/r (I - n n^T) unless
@@ -35,11 +41,22 @@ class SelfCollider final : public Collider {
   // out_i += scale * sum_j (d f_j / d x_i)^T w_j = -scale * sum_j J_ij w_j over the pairs of the updated
   // state (w, out: 3p). Parallel per particle i, each writing only its own entries.
   void add_cross_transpose(int n, const VecX& w, double scale, VecX& out) const override;
+  // Friction: the particle's pairs summed (slip u = v - v_j, v_j from update); the cross blocks and the
+  // damping blocks' derivatives over the pairs of the updated state in add_friction_coupled (parallel per
+  // particle, each writing only its own entries).
+  bool friction(int n, const Vec3& x, const Vec3& v, bool exact, ContactForce& out) const override;
+  void add_friction_coupled(int n, const VecX& w, const VecX& c, double scale, bool exact, VecX& xout,
+                            VecX& vout) const override;
 
   // Pair Jacobian J = d f_i / d x_i of one pair with offset d = x_i - x_j (|d| < thickness).
   Mat3 pair_jacobian(const Vec3& d, bool definite) const;
   // d/dd [w . Jd c] of one pair, Jd = pair_jacobian(d, definite = true).
   Vec3 pair_stiffness_derivative(const Vec3& d, const Vec3& w, const Vec3& c) const;
+  // Friction of one pair on particle i (offset d, slip u = v_i - v_j) and its exact d f_i / d x_i.
+  FrictionForce pair_friction(const Vec3& d, const Vec3& u, Mat3& dfdx) const;
+  // d/dd and d/du of [a . D(d, u) b], D = pair_friction(d, u).dfdu.
+  void pair_damping_derivative(const Vec3& d, const Vec3& u, const Vec3& a, const Vec3& b, Vec3& ddd,
+                               Vec3& ddu) const;
 
   void set_counting(bool on) { counting_ = on; }
   // Particle contacts counted since the last take (each pair counts twice).
@@ -53,7 +70,7 @@ class SelfCollider final : public Collider {
   int p_;
   double thickness_;
   ContactProfile profile_;
-  VecX x_;
+  VecX x_, v_;
   std::vector<std::pair<int64_t, int>> cells_;  // (cell key, particle), sorted
   bool counting_ = false;
   mutable std::atomic<int> count_{0};

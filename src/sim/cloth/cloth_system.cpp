@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "sim/cloth/air_drag.h"
 #include "sim/cloth/gravity.h"
+#include "sim/cloth/imperfection.h"
 #include "sim/cloth/spring_damping.h"
 #include "sim/make_system.h"
 
@@ -63,6 +64,7 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   x0_.resize(3 * p_);
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) seg(x0_, spec.index(i, j)) = spec.origin + i * dx * spec.u_axis + j * dy * spec.v_axis;
+  add_imperfection(x0_, spec.u_axis.cross(spec.v_axis), spec.imperfection, uint64_t(spec.imperfection_seed));
 
   auto add = [&](int a, int b, double k) {
     BucklingSpring s;

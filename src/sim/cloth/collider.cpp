@@ -35,6 +35,41 @@ bool DistanceCollider::contact(int, const Vec3& x, const Vec3&, bool definite, C
   return true;
 }
 
+bool DistanceCollider::friction(int, const Vec3& x, const Vec3& v, bool exact, ContactForce& out) const {
+  if (!friction_.on()) return false;
+  double phi;
+  Vec3 n;
+  Mat3 dn;
+  distance(x, phi, n, dn);
+  if (phi >= thickness_) return false;
+  double g, dg, ddg;
+  profile_.eval(thickness_ - phi, g, dg, ddg);
+  // Limit L = mu g(thickness - phi): dL/dx = -mu g' n. The surface is still: the slip is v itself.
+  const FrictionForce fr = friction_force(friction_.mu * g, n, v, friction_.eps);
+  out.f = fr.f;
+  out.dfdv = fr.dfdu;
+  out.dfdx.setZero();
+  if (exact) out.dfdx = fr.dfdL * (-friction_.mu * dg * n).transpose() + fr.dfdn * dn;
+  return true;
+}
+
+void DistanceCollider::damping_derivative(int, const Vec3& x, const Vec3& v, const Vec3& w, const Vec3& c,
+                                          Vec3& ddx, Vec3& ddv) const {
+  ddx.setZero();
+  ddv.setZero();
+  if (!friction_.on()) return;
+  double phi;
+  Vec3 n;
+  Mat3 dn;
+  distance(x, phi, n, dn);
+  if (phi >= thickness_) return;
+  double g, dg, ddg;
+  profile_.eval(thickness_ - phi, g, dg, ddg);
+  const FrictionDampingDerivative d = friction_damping_derivative(friction_.mu * g, n, v, friction_.eps, w, c);
+  ddx = d.dL * (-friction_.mu * dg * n) + dn.transpose() * d.dn;
+  ddv = d.du;
+}
+
 double DistanceCollider::energy(int, const Vec3& x) const {
   double phi;
   Vec3 n;

@@ -9,12 +9,20 @@
 // Jacobians: the exact df/dx = -g' n n^T + g dn/dx; the definite one (what the implicit matrix holds)
 // keeps -g' n n^T. The exact adjoint also needs the position derivative of that definite block met by
 // two vectors (definite_stiffness_derivative).
+//
+// Friction (FrictionParams, sim/cloth/friction.h; the cloth's FrictionTerm sums it) is the smoothed Coulomb
+// force of limit mu g against the velocity relative to the surface, apart from contact(). Its df/dv is a
+// damping block (symmetric, negative semi-definite, held by the implicit matrix); its df/dx (through g, n
+// and, on a moving surface, the surface's velocity at the closest point) is only in the exact Jacobian.
+// Since df/dv depends on x and v, the exact adjoint also needs d/dx and d/dv of w . D(x, v) c
+// (damping_derivative).
 #include <memory>
 #include <vector>
 
 #include "core/types.h"
 #include "scene/cloth_spec.h"
 #include "sim/cloth/contact_profile.h"
+#include "sim/cloth/friction.h"
 
 namespace kf {
 
@@ -45,6 +53,33 @@ class Collider {
                                                  VecX& out) const;
   // Adds scale * C^T w, C the blocks of the exact df/dx that couple two particles (none by default).
   virtual void add_cross_transpose(int /*n*/, const VecX& /*w*/, double /*scale*/, VecX& /*out*/) const {}
+
+  // Friction of the particle at x moving with v at step n (FrictionParams; sim/cloth/friction.h): its force,
+  // its damping block dfdv (what the implicit matrix holds) and, when `exact`, its df/dx (else zero).
+  // Returns false (and leaves `out` untouched) without friction or contact. A pair collider gathers the
+  // particle's pairs here and puts the blocks coupling two particles in add_friction_coupled.
+  virtual bool friction(int /*n*/, const Vec3& /*x*/, const Vec3& /*v*/, bool /*exact*/, ContactForce& /*out*/) const {
+    return false;
+  }
+  // d/dx and d/dv of [w . D(x, v) c], D the dfdv of friction() (both zero out of contact, without friction,
+  // and for pair colliders, which need both ends: add_friction_coupled carries theirs).
+  virtual void damping_derivative(int /*n*/, const Vec3& /*x*/, const Vec3& /*v*/, const Vec3& /*w*/,
+                                  const Vec3& /*c*/, Vec3& ddx, Vec3& ddv) const {
+    ddx.setZero();
+    ddv.setZero();
+  }
+  // A pair collider's friction couplings over the state it was updated with (w, c, xout, vout: 3p):
+  // xout += scale * Cx^T w and vout += scale * Cv^T w, Cx and Cv the blocks of the exact df/dx and of
+  // df/dv that couple two particles (the implicit matrix holds neither), and, when `exact`, xout += scale
+  // * d/dx [w^T D c] and vout += scale * d/dv [w^T D c] over its pairs. Nothing by default.
+  virtual void add_friction_coupled(int /*n*/, const VecX& /*w*/, const VecX& /*c*/, double /*scale*/, bool /*exact*/,
+                                    VecX& /*xout*/, VecX& /*vout*/) const {}
+
+  const FrictionParams& friction_params() const { return friction_; }
+  void set_friction(const FrictionParams& f) { friction_ = f; }
+
+ protected:
+  FrictionParams friction_;  // off unless set
 };
 
 // A signed-distance collider: the analytic shapes only supply phi, n and dn/dx.
@@ -54,6 +89,9 @@ class DistanceCollider : public Collider {
   DistanceCollider(double thickness, double stiffness, double ramp) : thickness_(thickness), profile_{stiffness, ramp} {}
   bool contact(int n, const Vec3& x, const Vec3& v, bool definite, ContactForce& out) const override;
   Vec3 definite_stiffness_derivative(int n, const Vec3& x, const Vec3& w, const Vec3& c) const override;
+  bool friction(int n, const Vec3& x, const Vec3& v, bool exact, ContactForce& out) const override;
+  void damping_derivative(int n, const Vec3& x, const Vec3& v, const Vec3& w, const Vec3& c, Vec3& ddx,
+                          Vec3& ddv) const override;
   double energy(int n, const Vec3& x) const override;
   // Signed distance phi (m), outward unit normal n and dn/dx (3x3, 1/m) at x.
   virtual void distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const = 0;

@@ -1,0 +1,98 @@
+// Robustness sweep: scenes written the way a new user writes them (scenes/robustness/), each optimised with
+// `keyframe optimize`'s own job at its default settings and judged by its keyframes (opt/diagnosis.h).
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include "bench/bench_point.h"
+#include "bench/bench_sweeps.h"
+#include "app/optimize_job.h"
+#include "report/plot.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+
+namespace kf {
+
+namespace {
+
+// The scene names in `dir` (every *.json, sorted) when none are given.
+std::vector<std::string> suite_scenes(const RobustnessSweepOptions& o) {
+  if (!o.scenes.empty()) return o.scenes;
+  std::vector<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(o.scene_dir))
+    if (e.path().extension() == ".json") names.push_back(e.path().stem().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// What the optimiser did, as the table names it: the report's strategy when it states one, else the
+// control kind of each stage.
+std::string strategy_of(const nlohmann::json& report) {
+  if (report.contains("strategy") && report.at("strategy").is_string()) return report.at("strategy").get<std::string>();
+  std::string s;
+  for (const auto& st : report.at("stage_results")) s += (s.empty() ? "" : " then ") + st.at("kind").get<std::string>();
+  return "L-BFGS " + s;
+}
+
+}  // namespace
+
+nlohmann::json bench_robustness(const RobustnessSweepOptions& o, const std::filesystem::path& out) {
+  CsvTable t({"scene", "system", "strategy", "keyframe", "error_before", "error_after", "tolerance", "miss_before",
+              "miss_after", "evaluations", "seconds", "outcome", "pass"});
+  nlohmann::json summary;
+  int passed = 0, rows = 0;
+  for (const std::string& name : suite_scenes(o)) {
+    const std::filesystem::path file = o.scene_dir / (name + ".json");
+    OptimizeOptions opt;
+    opt.out = (o.runs_dir / name).string();
+    opt.quiet = true;
+    opt.max_evaluations = o.max_evaluations;
+    opt.max_seconds = o.max_seconds;
+    std::cerr << "bench robustness: " << name << std::endl;
+    const auto start = std::chrono::steady_clock::now();
+    OptimizeOutcome outcome;
+    try {
+      outcome = optimize_job(file, opt);
+    } catch (const InputError& e) {
+      std::cerr << "bench robustness: skipping " << name << ": " << e.what() << std::endl;
+      summary["skipped"].push_back(name + ": " + e.what());
+      continue;
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::ifstream in(outcome.dir / "report.json");
+    const nlohmann::json report = nlohmann::json::parse(in);
+    ensure_directory(out / "reports");
+    write_file_atomic(out / "reports" / (name + ".json"), report.dump(1) + "\n");
+    // The scene's worst keyframe (by its miss after the optimisation) stands for it in the table.
+    const nlohmann::json* worst = nullptr;
+    for (const auto& k : report.at("keyframe_errors"))
+      if (k.at("judged").get<bool>() &&
+          (!worst || k.at("miss_after").get<double>() > worst->at("miss_after").get<double>()))
+        worst = &k;
+    if (!worst) continue;
+    const bool pass = report.at("diagnosis").at("reached").get<bool>() && seconds <= o.pass_seconds;
+    passed += pass;
+    ++rows;
+    const std::string system = report.at("system").get<std::string>();
+    auto text = [&](const char* key) { return worst->at(key).get<std::string>(); };
+    t.add({name, system.substr(0, system.find_first_of(": ")), strategy_of(report), text("name"), text("error_before"),
+           text("error_after"), text("tolerance"), fmt(worst->at("miss_before").get<double>()),
+           fmt(worst->at("miss_after").get<double>()), std::to_string(report.at("evaluations").get<int>()),
+           fmt(seconds), report.at("diagnosis").at("outcome").get<std::string>(), pass ? "yes" : "no"});
+    summary["diagnoses"][name] = outcome.diagnosis;
+  }
+  const auto csv = out / "robustness.csv";
+  t.write(csv);
+  if (rows > 0)
+    bar_plot_csv(csv, out / "robustness.png",
+                 "worst keyframe error over its tolerance, uncontrolled and optimised (1: met)", {t.col("scene")},
+                 {t.col("miss_before"), t.col("miss_after")});
+  summary["passed"] = passed;
+  summary["scenes"] = rows;
+  std::cout << "robustness.csv: " << passed << " of " << rows << " scenes pass\n" << t.excerpt(100) << std::endl;
+  return summary;
+}
+
+}  // namespace kf

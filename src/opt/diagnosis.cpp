@@ -1,0 +1,241 @@
+#include "opt/diagnosis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "core/overloaded.h"
+#include "opt/gradcheck.h"
+#include "opt/problem.h"
+#include "sim/make_system.h"
+
+namespace kf {
+
+namespace {
+
+// A budget this small says nothing about whether more evaluations would reach the keyframes.
+constexpr int kFewEvaluations = 50;
+
+std::string format(const char* fmt, double a, double b = 0) {
+  char buf[1024];
+  std::snprintf(buf, sizeof buf, fmt, a, b);
+  return buf;
+}
+
+std::string centimetres(double metres) { return format("%.2f cm", 100 * metres); }
+
+double number(const nlohmann::json& m, const char* key, double fallback = 0) {
+  return m.contains(key) && m.at(key).is_number() ? m.at(key).get<double>() : fallback;
+}
+
+// Fills miss, error text and tolerance text of one judgement from one measure; `after` selects which side.
+struct Judge {
+  const Scene& scene;
+  const ObjectiveSpec& o;
+  KeyframeJudgement& k;
+
+  void distance(const nlohmann::json& mb, const nlohmann::json& ma, const char* key, double tol) {
+    k.judged = true;
+    k.miss_before = number(mb, key) / tol;
+    k.miss_after = number(ma, key) / tol;
+    k.error_before = centimetres(number(mb, key));
+    k.error_after = centimetres(number(ma, key));
+    k.tolerance = centimetres(tol);
+  }
+
+  void operator()(const nlohmann::json& mb, const nlohmann::json& ma) {
+    const double sheet = scene.cloth ? std::max(scene.cloth->width, scene.cloth->height) : 0.0;
+    const double cloth_tol = std::max(0.01, 0.01 * sheet);
+    std::visit(Overloaded{
+                   [&](const PositionKeyframe&) {
+                     if (scene.cloth) return distance(mb, ma, "rms_error", cloth_tol);
+                     if (ma.contains("racer_rank")) {  // a race: the agent first along the heading
+                       k.judged = true;
+                       k.miss_before = number(mb, "racer_rank");
+                       k.miss_after = number(ma, "racer_rank");
+                       k.error_before = format("rank %.0f", k.miss_before);
+                       k.error_after = format("rank %.0f", k.miss_after);
+                       k.tolerance = "rank 1";
+                       return;
+                     }
+                     distance(mb, ma, "rms_error", 0.1);
+                   },
+                   [&](const VelocityKeyframe&) {
+                     k.error_before = format("%.3g m/s", number(mb, "rms_error"));
+                     k.error_after = format("%.3g m/s", number(ma, "rms_error"));
+                   },
+                   [&](const CenterOfMassKeyframe&) {
+                     if (scene.cloth) return distance(mb, ma, "error", cloth_tol);
+                     distance(mb, ma, "error", std::max(0.01, 0.02 * number(ma, "path_length")));
+                   },
+                   [&](const ShapeKeyframe& s) {
+                     const bool coverage = s.coverage_weight > 0;
+                     auto miss = [&](const nlohmann::json& m) {
+                       const double in = (1 - number(m, "inside_fraction")) / (1 - 0.95);
+                       return coverage ? std::max(in, (1 - number(m, "coverage_fraction")) / (1 - 0.9)) : in;
+                     };
+                     auto text = [&](const nlohmann::json& m) {
+                       return coverage ? format("inside %.3f coverage %.3f", number(m, "inside_fraction"),
+                                                number(m, "coverage_fraction"))
+                                       : format("inside %.3f", number(m, "inside_fraction"));
+                     };
+                     k.judged = true;
+                     k.miss_before = miss(mb);
+                     k.miss_after = miss(ma);
+                     k.error_before = text(mb);
+                     k.error_after = text(ma);
+                     k.tolerance = coverage ? "inside >= 0.95 and coverage >= 0.9" : "inside >= 0.95";
+                   },
+                   [&](const ArchKeyframe&) {
+                     distance(mb, ma, "rms_distance", 0.01 * std::max(number(ma, "width"), 1e-9));
+                   },
+               },
+               o.kind);
+  }
+};
+
+}  // namespace
+
+nlohmann::json KeyframeJudgement::to_json() const {
+  nlohmann::json j = {{"name", name},
+                      {"frame", frame},
+                      {"judged", judged},
+                      {"error_before", error_before},
+                      {"error_after", error_after},
+                      {"met", met()}};
+  if (judged) {
+    j["tolerance"] = tolerance;
+    j["miss_before"] = miss_before;
+    j["miss_after"] = miss_after;
+  }
+  return j;
+}
+
+std::vector<KeyframeJudgement> judge_keyframes(const Scene& scene, const nlohmann::json& before,
+                                               const nlohmann::json& after) {
+  std::vector<KeyframeJudgement> out;
+  for (size_t i = 0; i < scene.objectives.size(); ++i) {
+    const ObjectiveSpec& o = scene.objectives[i];
+    KeyframeJudgement k;
+    k.name = std::string(type_name(o)) + "@" + std::to_string(o.frame);
+    k.frame = o.frame;
+    Judge{scene, o, k}(before.at(i), after.at(i));
+    out.push_back(std::move(k));
+  }
+  return out;
+}
+
+nlohmann::json Sensitivity::to_json() const {
+  return {{"keyframe", keyframe},
+          {"gradient_by_frame", gradient_by_frame},
+          {"gradient_growth", growth},
+          {"gradient_growth_beyond_free_flight", growth_beyond_free},
+          {"gradient_grows_from_frame", grows_from_frame},
+          {"objective_start", phi},
+          {"objective_noise_start", phi_noise},
+          {"objective_relative_noise_start", relative_noise()}};
+}
+
+Sensitivity measure_sensitivity(const Scene& scene, const TimeSpec& time) {
+  Sensitivity s;
+  for (const auto& o : scene.objectives) s.keyframe = std::max(s.keyframe, o.frame);
+  Scene probe = scene;
+  probe.controls.kind = ControlKind::kPerFrame;
+  probe.controls.from_frame = 0;
+  const auto sys = make_system(probe, time.h());
+  Problem problem(probe, time, *sys);
+  const VecX z = problem.initial_guess();
+  VecX g;
+  s.phi = problem.evaluate(z, &g);
+  if (problem.last_diverged()) return s;
+  s.phi_noise = phi_noise(problem, z, s.phi, 11);
+  VecX u;
+  for (int f = 0; f < s.keyframe; ++f) {
+    problem.controls().force_at(g, f * time.substeps, u);
+    s.gradient_by_frame.push_back(u.norm());
+  }
+  if (s.gradient_by_frame.empty()) return s;
+  const int k = s.keyframe;
+  const double last = s.gradient_by_frame.back(), most = *std::max_element(s.gradient_by_frame.begin(),
+                                                                          s.gradient_by_frame.end());
+  if (!(last > 0)) return s;  // the keyframes do not depend on the last frame's force (a shape met already)
+  s.growth = most / last;
+  s.growth_beyond_free = 0;
+  for (int f = 0; f < k; ++f) s.growth_beyond_free = std::max(s.growth_beyond_free, s.gradient_by_frame[f] / (last * (k - f)));
+  for (int f = 0; f < k; ++f)
+    if (s.gradient_by_frame[f] >= 0.1 * most) s.grows_from_frame = f;
+  return s;
+}
+
+nlohmann::json Diagnosis::to_json() const {
+  return {{"outcome", outcome}, {"reached", reached}, {"progress", progress}, {"far", far}, {"failed", failed()},
+          {"diagnosis", line}};
+}
+
+Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensitivity& s, const RunFacts& facts) {
+  Diagnosis d;
+  const KeyframeJudgement* worst = nullptr;
+  for (const auto& k : keyframes)
+    if (k.judged && (!worst || k.miss_after > worst->miss_after)) worst = &k;
+  d.reached = !worst || worst->miss_after <= 1.0;
+  d.far = worst && worst->miss_after > kFarMiss;
+  d.progress = facts.keyframe_objective_end <= 0.5 * facts.keyframe_objective_start;
+  const std::string budget = facts.budget ? " (it stopped at its budget: " + facts.status + ")" : "";
+  if (d.reached) {
+    d.outcome = "reached";
+    d.line = "reached its keyframes" + budget;
+    return d;
+  }
+  d.outcome = d.failed() ? (d.progress ? "not_reached" : "no_progress") : "near";
+  std::string what = worst->name + " is " + worst->error_after + " from its target (tolerance " + worst->tolerance +
+                     "; " + worst->error_before + " uncontrolled)";
+  if (worst->tolerance.find("inside") != std::string::npos)
+    what = worst->name + " ends at " + worst->error_after + " (needs " + worst->tolerance + "; " +
+           worst->error_before + " uncontrolled)";
+  std::string head = d.failed() ? (d.progress ? "keyframes not reached: " : "no progress: ") : "near its keyframes: ";
+  if (!d.progress)
+    head += format("the keyframe terms went from %.3g to %.3g; ", facts.keyframe_objective_start,
+                   facts.keyframe_objective_end);
+  std::string cause;
+  if (s.noisy()) {
+    cause = format("cause: the objective is noise at the start (it moves by %.2g of itself under perturbations "
+                   "of 1e-9): the start is a bifurcation, e.g. a flat sheet released in its own plane buckles "
+                   "whichever way round-off says; change: break the symmetry (a small initial velocity or offset "
+                   "out of plane) or put the keyframe later",
+                   s.relative_noise());
+  } else if (s.amplifying()) {
+    cause = format("cause: the motion amplifies perturbations: the gradient per frame grows %.2gx from the "
+                   "keyframe back to frame %.0f (folds, sliding or buckling in contact after it)",
+                   s.growth, s.grows_from_frame) +
+            "; change: steer over a window after that frame (controls.from_frame), keyframe earlier, or damp "
+            "the motion (cloth.damping, cloth.air_drag, friction)";
+    if (facts.max_objective > 1e6 * std::max(facts.objective_start, 1e-300))
+      cause += format("; trial steps reached an objective of %.2g from %.2g", facts.max_objective,
+                      facts.objective_start);
+  } else if (facts.budget && (facts.recent_improvement < 0.9 || facts.evaluations < kFewEvaluations)) {
+    cause = format("cause: its budget ended it after %.0f evaluations (the objective still fell %.2gx over the "
+                   "last tenth of them); change: raise optimizer.max_evaluations",
+                   facts.evaluations, 1 / std::max(facts.recent_improvement, 1e-300));
+  } else {
+    const double phi = facts.keyframe_objective_end + facts.effort_end;
+    const double effort_share = phi > 0 ? facts.effort_end / phi : 0.0;
+    if (effort_share > 0.5)
+      cause = format("cause: the control effort is %.0f %% of the objective: what is left of the keyframe terms "
+                     "costs less than the force that would remove it; change: raise the keyframe's weight or lower "
+                     "controls.alpha",
+                     100 * effort_share);
+    else
+      cause = format("cause: the dynamics are smooth (the gradient grows %.2gx over the horizon) and the "
+                     "optimiser stopped (",
+                     s.growth) +
+              facts.status +
+              format("), so the target is likely out of reach: inside or behind a collider, or costing more "
+                     "force than controls.alpha allows (the effort is %.0f %% of the objective); change: move the "
+                     "keyframe, give the controls more time, or lower controls.alpha",
+                     100 * effort_share);
+  }
+  d.line = head + what + budget + "; " + cause;
+  return d;
+}
+
+}  // namespace kf

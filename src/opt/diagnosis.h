@@ -1,0 +1,91 @@
+#pragma once
+// Whether an optimisation reached its keyframes and, when it did not, why and what to change.
+//
+// Each keyframe is judged by its figure measure against a tolerance (keyframe_tolerance below); its miss is
+// the error over the tolerance, so a miss of at most 1 is met. The run fails (keyframe optimize exits with
+// kExitNotReached) when some keyframe is not met and either the keyframe terms of φ fell by less than half
+// (no meaningful progress) or some keyframe misses by more than kFarMiss tolerances. The cause comes from
+// measurements at the start: how much the motion amplifies a perturbation on its way to the keyframe (the
+// gradient of φ with respect to a force held over each frame, from one adjoint pass) and how noisy φ is
+// under perturbations of 1e-9 (a bifurcation such as a flat sheet released in its own plane).
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/scene.h"
+
+namespace kf {
+
+// A keyframe whose error is more than this many tolerances is far from its target: the run failed even if
+// its objective fell.
+constexpr double kFarMiss = 3.0;
+
+// One keyframe (objective) of the scene, judged before (the uncontrolled run) and after the optimisation.
+struct KeyframeJudgement {
+  std::string name;        // "center_of_mass@30"
+  int frame = 0;
+  bool judged = false;     // false: no tolerance for this kind (velocity keyframes); never a miss
+  double miss_before = 0;  // error / tolerance: <= 1 is met
+  double miss_after = 0;
+  std::string error_before, error_after;  // the error in the measure's unit ("12.30 cm", "inside 0.620")
+  std::string tolerance;                  // "1.20 cm", "inside >= 0.95 and coverage >= 0.9"
+  bool met() const { return !judged || miss_after <= 1.0; }
+  nlohmann::json to_json() const;
+};
+
+// Judges scene.objectives[i] by measures[i] (figure_measures of the uncontrolled run and of the result).
+// Cloth position and centre-of-mass keyframes: RMS error within max(1 cm, 1 % of the sheet's longer side);
+// flock shapes: inside_fraction >= 0.95 and, when coverage is asked, coverage_fraction >= 0.9; flock
+// centre-of-mass keyframes: within 2 % of the centre of mass's path; a racer (one agent's position): first
+// along the heading; other flock positions within 0.1 m; arches: RMS distance within 1 % of the width.
+std::vector<KeyframeJudgement> judge_keyframes(const Scene& scene, const nlohmann::json& measures_before,
+                                               const nlohmann::json& measures_after);
+
+// How the uncontrolled motion propagates perturbations to the keyframes, measured at the start.
+struct Sensitivity {
+  // |∂φ/∂u_f| for a force u_f on every particle held over frame f, f = 0 .. keyframe - 1, at no control.
+  std::vector<double> gradient_by_frame;
+  int keyframe = 0;               // the last keyframe's frame
+  double growth = 1;              // max_f gradient_by_frame[f] / gradient_by_frame[keyframe - 1]
+  double growth_beyond_free = 1;  // the same over the growth of free flight, (keyframe − f): ~1 when smooth
+  int grows_from_frame = 0;       // the last frame whose gradient is within 10x of the largest
+  double phi = 0;                 // φ at the start (force controls held over frames, none applied)
+  double phi_noise = 0;           // φ's spread under perturbations of 1e-9 of the controls
+  double relative_noise() const { return phi != 0 ? phi_noise / std::abs(phi) : 0.0; }
+  bool noisy() const { return relative_noise() > 1e-6; }
+  bool amplifying() const { return growth_beyond_free > 1e3; }
+  nlohmann::json to_json() const;
+};
+
+// Simulates the scene at `time` (its own system, built here) under per-frame force controls and takes one
+// gradient and six more evaluations of φ. Keyframes at frame 0 only: an empty gradient_by_frame.
+Sensitivity measure_sensitivity(const Scene& scene, const TimeSpec& time);
+
+// What the optimiser's run shows besides its keyframes.
+struct RunFacts {
+  std::string status;                // why the last stage stopped
+  bool budget = false;               // it stopped at an evaluation or time limit
+  double keyframe_objective_start = 0;  // φ without the effort term, first and best evaluation
+  double keyframe_objective_end = 0;
+  double effort_end = 0;             // the effort term at the end
+  double max_objective = 0;          // the largest φ any trial point gave
+  double objective_start = 0;        // φ at the first evaluation
+  double recent_improvement = 1;     // best φ at the end over the best φ 10 % of the evaluations earlier
+  int evaluations = 0;
+};
+
+struct Diagnosis {
+  bool reached = false;   // every judged keyframe met
+  bool progress = false;  // the keyframe terms fell to at most half
+  bool far = false;       // some keyframe misses by more than kFarMiss tolerances
+  bool failed() const { return !reached && (!progress || far); }
+  std::string outcome;    // "reached", "near", "not_reached", "no_progress"
+  std::string line;       // one line for the user: what happened, the cause, what to change
+  nlohmann::json to_json() const;
+};
+
+Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensitivity& sensitivity,
+                   const RunFacts& facts);
+
+}  // namespace kf

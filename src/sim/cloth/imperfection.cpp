@@ -1,0 +1,16 @@
+#include "sim/cloth/imperfection.h"
+
+#include <random>
+
+namespace kf {
+
+void add_imperfection(VecX& x, const Vec3& normal, double amplitude, uint64_t seed) {
+  if (amplitude == 0) return;
+  std::mt19937_64 rng(seed);  // its output sequence is fixed by the standard; the mapping below is ours
+  for (int i = 0; i < int(x.size() / 3); ++i) {
+    const double unit = double(rng() >> 11) * 0x1.0p-53;  // [0, 1)
+    seg(x, i) += amplitude * (2 * unit - 1) * normal;
+  }
+}
+
+}  // namespace kf

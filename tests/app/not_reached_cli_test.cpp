@@ -1,0 +1,98 @@
+// An optimisation that does not reach its keyframes ends with exit code 7 and one line naming the cause,
+// after writing its run directory; one that reaches them exits 0 and says so. Small scenes a new user
+// would write: a flag released flat in its own plane (a bifurcation: the objective is noise), a sheet
+// dropped onto a sphere (contact amplifies every perturbation), a hanging sheet asked to reach a point it
+// cannot (the target is out of reach).
+#include <nlohmann/json.hpp>
+
+#include "../reliability/cli_harness.h"
+#include "app/optimize_job.h"
+#include "core/error.h"
+
+namespace kf::reliability {
+namespace {
+
+class NotReached : public TempDirTest {
+ protected:
+  // Optimises `scene` and returns the result; the run directory "run" must hold a report either way.
+  CliResult optimise(const std::string& scene) {
+    write("scene.json", scene);
+    CliResult r = run_keyframe("optimize scene.json --quiet --out run", dir_);
+    report_ = nlohmann::json::parse(read_text(dir_ / "run" / "report.json"));
+    EXPECT_TRUE(fs::is_regular_file(dir_ / "run" / "trajectory.bin")) << "the run directory was not written";
+    return r;
+  }
+  const nlohmann::json& diagnosis() const { return report_.at("diagnosis"); }
+  nlohmann::json report_;
+};
+
+TEST_F(NotReached, FlagReleasedFlatInItsPlaneIsANoisyStart) {
+  const CliResult r = optimise(R"({"time": {"fps": 30, "frames": 12},
+    "cloth": {"nx": 20, "ny": 12, "width": 1.2, "height": 0.72, "mass": 0.3, "origin": [0, 1.0, 0],
+              "u_axis": [1, 0, 0], "v_axis": [0, 1, 0], "pins": [0, 220]},
+    "objectives": [{"type": "position", "frame": 12, "particles": [239], "targets": [[0.6, 1.2, 0.3]]}],
+    "controls": {"kind": "per_frame"}, "optimizer": {"max_evaluations": 20}})");
+  EXPECT_EQ(r.code, kExitNotReached) << r.output;
+  EXPECT_NE(r.output.find("noise at the start"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("break the symmetry"), std::string::npos) << r.output;
+  EXPECT_TRUE(diagnosis().at("failed").get<bool>());
+  EXPECT_GT(report_.at("sensitivity").at("objective_relative_noise_start").get<double>(), 1e-6);
+  ASSERT_EQ(report_.at("keyframe_errors").size(), 1u);
+  EXPECT_FALSE(report_.at("keyframe_errors")[0].at("met").get<bool>());
+  ASSERT_EQ(report_.at("stage_results").size(), 1u);
+  const auto& stage = report_.at("stage_results")[0];
+  EXPECT_EQ(stage.at("kind"), "per_frame");
+  EXPECT_GT(stage.at("evaluations").get<int>(), 0);
+  EXPECT_TRUE(stage.at("objective_start").is_number() && stage.at("objective_end").is_number());
+}
+
+TEST_F(NotReached, FlagWithASmallOutOfPlaneStartIsNotNoisy) {
+  // The same flag with 1 cm/s across its plane: the start is no longer a bifurcation.
+  optimise(R"({"time": {"fps": 30, "frames": 12},
+    "cloth": {"nx": 20, "ny": 12, "width": 1.2, "height": 0.72, "mass": 0.3, "origin": [0, 1.0, 0],
+              "u_axis": [1, 0, 0], "v_axis": [0, 1, 0], "pins": [0, 220], "velocity": [0, 0, 0.01]},
+    "objectives": [{"type": "position", "frame": 12, "particles": [239], "targets": [[0.6, 1.2, 0.3]]}],
+    "controls": {"kind": "per_frame"}, "optimizer": {"max_evaluations": 2}})");
+  EXPECT_LT(report_.at("sensitivity").at("objective_relative_noise_start").get<double>(), 1e-6);
+}
+
+TEST_F(NotReached, SheetOnASphereAmplifiesPerturbations) {
+  const CliResult r = optimise(R"({"time": {"fps": 30, "frames": 24},
+    "cloth": {"nx": 12, "ny": 12, "width": 1.2, "height": 1.2, "mass": 0.4, "origin": [-0.6, 0.9, -0.6],
+              "u_axis": [1, 0, 0], "v_axis": [0, 0, 1],
+              "colliders": [{"type": "sphere", "center": [0, 0.5, 0], "radius": 0.3}, {"type": "ground"}]},
+    "objectives": [{"type": "center_of_mass", "frame": 24, "target": [0.1, 0.5, 0]},
+                   {"type": "position", "frame": 24, "particles": [0], "targets": [[-0.2, 0.2, -0.3]]}],
+    "controls": {"kind": "per_frame"}, "optimizer": {"max_evaluations": 20}})");
+  EXPECT_EQ(r.code, kExitNotReached) << r.output;
+  EXPECT_NE(r.output.find("amplifies perturbations"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("controls.from_frame"), std::string::npos) << r.output;
+  const auto& s = report_.at("sensitivity");
+  EXPECT_GT(s.at("gradient_growth_beyond_free_flight").get<double>(), 1e3) << s.dump();
+  EXPECT_EQ(s.at("gradient_by_frame").size(), 24u);
+}
+
+TEST_F(NotReached, TargetOutOfReachOfAHangingSheet) {
+  // Pinned along its top edge 1 m up, a 1 m sheet cannot put its centre of mass 3 m below the pins.
+  const CliResult r = optimise(R"({"time": {"fps": 30, "frames": 10},
+    "cloth": {"nx": 5, "ny": 5, "width": 1, "height": 1, "pins": "top_edge"},
+    "objectives": [{"type": "center_of_mass", "frame": 10, "target": [0.5, -2, 0]}],
+    "controls": {"kind": "per_frame", "alpha": 0.01}})");
+  EXPECT_EQ(r.code, kExitNotReached) << r.output;
+  EXPECT_NE(r.output.find("out of reach"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("center_of_mass@10"), std::string::npos) << r.output;
+}
+
+TEST_F(NotReached, ReachableKeyframeExitsZeroAndSaysSo) {
+  const CliResult r = optimise(R"({"time": {"fps": 30, "frames": 10},
+    "cloth": {"nx": 5, "ny": 5, "width": 1, "height": 1, "pins": "top_edge"},
+    "objectives": [{"type": "center_of_mass", "frame": 10, "target": [0.5, 0.5, 0.1]}],
+    "controls": {"kind": "per_frame", "alpha": 1e-6}})");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("reached its keyframes"), std::string::npos) << r.output;
+  EXPECT_EQ(diagnosis().at("outcome"), "reached");
+  EXPECT_TRUE(report_.at("keyframe_errors")[0].at("met").get<bool>());
+}
+
+}  // namespace
+}  // namespace kf::reliability

@@ -1,0 +1,124 @@
+// Judging keyframes against their tolerances, and the cause a failed optimisation is given: synthetic
+// measures for the rules, small real scenes for the measurements behind the causes.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "opt/diagnosis.h"
+#include "scene/scene.h"
+
+namespace kf {
+namespace {
+
+using nlohmann::json;
+
+const char* kSheetOnSphere = R"({
+  "time": {"fps": 30, "frames": 24},
+  "cloth": {"nx": 12, "ny": 12, "width": 1.2, "height": 1.2, "mass": 0.4, "origin": [-0.6, 0.9, -0.6],
+            "u_axis": [1, 0, 0], "v_axis": [0, 0, 1],
+            "colliders": [{"type": "sphere", "center": [0, 0.5, 0], "radius": 0.3}, {"type": "ground"}]},
+  "objectives": [{"type": "center_of_mass", "frame": 24, "target": [0.1, 0.5, 0]},
+                 {"type": "position", "frame": 24, "particles": [0], "targets": [[-0.2, 0.2, -0.3]]}],
+  "controls": {"kind": "per_frame"}})";
+
+TEST(Diagnosis, ClothKeyframesAreJudgedAgainstOneCentimetreOrOnePercentOfTheSheet) {
+  const Scene scene = parse_scene(kSheetOnSphere, "sheet.json");
+  const json before = json::parse(R"([{"error": 0.15}, {"rms_error": 0.30}])");
+  const json after = json::parse(R"([{"error": 0.011}, {"rms_error": 0.013}])");
+  const auto k = judge_keyframes(scene, before, after);
+  ASSERT_EQ(k.size(), 2u);
+  EXPECT_EQ(k[0].name, "center_of_mass@24");
+  EXPECT_TRUE(k[0].judged);
+  EXPECT_NEAR(k[0].miss_before, 0.15 / 0.012, 1e-12);  // 1 % of 1.2 m beats 1 cm
+  EXPECT_TRUE(k[0].met());
+  EXPECT_FALSE(k[1].met());
+  EXPECT_EQ(k[1].error_after, "1.30 cm");
+  EXPECT_EQ(k[1].tolerance, "1.20 cm");
+}
+
+TEST(Diagnosis, FlockShapesNeedInsideAndCoverageOnlyWhereCoverageIsAsked) {
+  const Scene scene = parse_scene(R"({"time": {"frames": 10}, "flock": {"agents": 10},
+    "objectives": [{"type": "shape", "frame": 10, "polygon": [[0, 0], [5, 0], [5, 5]], "coverage": {"weight": 1}},
+                   {"type": "shape", "frame": 10, "polygon": [[0, 0], [5, 0], [5, 5]]}]})",
+                                  "flock.json");
+  const json m = json::parse(R"([{"inside_fraction": 0.96, "coverage_fraction": 0.85},
+                                 {"inside_fraction": 0.96, "coverage_fraction": 0.10}])");
+  const auto k = judge_keyframes(scene, m, m);
+  EXPECT_FALSE(k[0].met());  // coverage 0.85 < 0.9
+  EXPECT_NEAR(k[0].miss_after, 1.5, 1e-12);
+  EXPECT_TRUE(k[1].met());   // no coverage asked
+  EXPECT_EQ(k[1].error_after, "inside 0.960");
+}
+
+std::vector<KeyframeJudgement> one_keyframe(double before, double after) {
+  KeyframeJudgement k;
+  k.name = "center_of_mass@24";
+  k.judged = true;
+  k.miss_before = before;
+  k.miss_after = after;
+  k.error_before = "15.00 cm";
+  k.error_after = "5.00 cm";
+  k.tolerance = "1.00 cm";
+  return {k};
+}
+
+RunFacts facts(double start, double end, const std::string& status = "converged") {
+  RunFacts f;
+  f.status = status;
+  f.budget = status.find("limit reached") != std::string::npos;
+  f.keyframe_objective_start = start;
+  f.keyframe_objective_end = end;
+  f.objective_start = start;
+  f.max_objective = start;
+  return f;
+}
+
+TEST(Diagnosis, OutcomeFollowsProgressAndDistance) {
+  const Sensitivity smooth;
+  Diagnosis d = diagnose(one_keyframe(15, 0.5), smooth, facts(10, 0.01, "evaluation limit reached"));
+  EXPECT_EQ(d.outcome, "reached");
+  EXPECT_FALSE(d.failed());
+  EXPECT_NE(d.line.find("budget"), std::string::npos) << d.line;
+  d = diagnose(one_keyframe(15, 2), smooth, facts(10, 0.1));  // progress, within kFarMiss tolerances
+  EXPECT_EQ(d.outcome, "near");
+  EXPECT_FALSE(d.failed());
+  d = diagnose(one_keyframe(15, 5), smooth, facts(10, 1));  // progress, but far
+  EXPECT_EQ(d.outcome, "not_reached");
+  EXPECT_TRUE(d.failed());
+  d = diagnose(one_keyframe(15, 2), smooth, facts(10, 9));  // near, but no progress on the objective
+  EXPECT_EQ(d.outcome, "no_progress");
+  EXPECT_TRUE(d.failed());
+  EXPECT_NE(d.line.find("no progress"), std::string::npos) << d.line;
+}
+
+TEST(Diagnosis, CauseNamesNoiseThenAmplificationThenBudgetThenReach) {
+  Sensitivity s;
+  s.phi = 15;
+  s.phi_noise = 1.8;
+  s.growth = s.growth_beyond_free = 1e12;
+  s.grows_from_frame = 6;
+  const auto k = one_keyframe(15, 14);
+  EXPECT_NE(diagnose(k, s, facts(10, 9)).line.find("noise at the start"), std::string::npos);
+  s.phi_noise = 1e-14;
+  std::string line = diagnose(k, s, facts(10, 9)).line;
+  EXPECT_NE(line.find("amplifies perturbations"), std::string::npos) << line;
+  EXPECT_NE(line.find("frame 6"), std::string::npos) << line;
+  s.growth = s.growth_beyond_free = 1.5;
+  RunFacts f = facts(10, 9, "evaluation limit reached");
+  f.evaluations = 300;
+  f.recent_improvement = 0.5;
+  line = diagnose(k, s, f).line;
+  EXPECT_NE(line.find("budget ended it"), std::string::npos) << line;
+  f.recent_improvement = 1;  // stalled at a large budget: no longer the budget's fault
+  EXPECT_EQ(diagnose(k, s, f).line.find("budget ended it"), std::string::npos);
+  line = diagnose(k, s, facts(10, 9)).line;
+  EXPECT_NE(line.find("out of reach"), std::string::npos) << line;
+  f = facts(10, 9);
+  f.effort_end = 20;  // the effort outweighs what is left of the keyframes
+  line = diagnose(k, s, f).line;
+  EXPECT_NE(line.find("lower controls.alpha"), std::string::npos) << line;
+  EXPECT_NE(line.find("effort is 69 %"), std::string::npos) << line;
+}
+
+}  // namespace
+}  // namespace kf
