@@ -21,6 +21,7 @@
 #include "opt/diagnosis.h"
 #include "report/figure_measures.h"
 #include "opt/optimizer.h"
+#include "opt/windows.h"
 #include "sim/make_system.h"
 
 namespace kf {
@@ -292,9 +293,14 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (opt.max_seconds >= 0) scene.optimizer.max_seconds = opt.max_seconds;
   const fs::path dir = resuming ? fs::path(opt.resume) : run_dir_for(scene, opt.out);
 
+  // Memory is checked at the scene's own time step before the stages are planned: planning a sensitive
+  // cloth simulates it once, which a run too large for the machine must not attempt.
+  const std::uint64_t memory_limit = opt.max_memory.empty() ? 0 : parse_memory_size(opt.max_memory);
+  const int checkpoint_every = opt.checkpoint_every >= 0 ? opt.checkpoint_every : scene.optimizer.checkpoint_every;
+  check_memory(scene, optimize_memory(scene, scene.time.substeps, checkpoint_every), memory_limit);
   // The stages of coarse-to-fine continuation; a resumed run continues in the last stage.
-  std::vector<StageSpec> stages = scene.optimizer.schedule;
-  if (stages.empty()) stages.push_back({scene.time.substeps, scene.optimizer.max_evaluations});
+  const StagePlan plan = plan_stages(scene);
+  std::vector<StageSpec> stages = plan.stages;
   if (opt.max_evaluations >= 0)
     for (auto& s : stages) s.max_evaluations = opt.max_evaluations;
   JobResult job;
@@ -309,14 +315,12 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     stages.erase(stages.begin(), stages.end() - 1);
   }
   {
-    const std::uint64_t limit = opt.max_memory.empty() ? 0 : parse_memory_size(opt.max_memory);
-    const int every = opt.checkpoint_every >= 0 ? opt.checkpoint_every : scene.optimizer.checkpoint_every;
     MemoryEstimate need;
     for (const auto& st : stages) {
-      const MemoryEstimate e = optimize_memory(scene, st.substeps, every);
+      const MemoryEstimate e = optimize_memory(scene, st.substeps, checkpoint_every);
       if (e.bytes > need.bytes) need = e;
     }
-    check_memory(scene, need, limit);
+    check_memory(scene, need, memory_limit);
   }
   // Build the first system before writing anything, so bad scenes leave no trace.
   TimeSpec& time = job.time;
@@ -331,6 +335,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   else naming_run_dir(staged, [&] { prepare_run_dir(work, scene); });
 
   EvaluationLog elog(opt.quiet);
+  if (!plan.why.empty() && !resuming) elog.say(plan.why);
   SignalGuard signals;
   for (size_t s = 0; s < stages.size() && !job.interrupted; ++s) {
     time.substeps = stages[s].substeps;
@@ -338,6 +343,8 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     Scene stage_scene = scene;  // a stage may optimise a coarser control parameterisation
     if (stages[s].controls) stage_scene.controls = *stages[s].controls;
     VecX& z = job.z;
+    // The first frame of the previous stage's forces (a resumed run's controls are the scene's).
+    const int z_from_frame = job.problem ? job.problem->controls().first_frame() : scene.controls.from_frame;
     VecX v0_before;  // the initial velocities the previous stage's kind gave, when the kind changes
     if (job.problem && job.problem->controls().kind() != std::string(control_kind_name(stage_scene.controls.kind)))
       job.problem->controls().initial_velocity(z, v0_before);
@@ -346,7 +353,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     if (opt.checkpoint_every >= 0) problem.set_checkpoint_every(opt.checkpoint_every);
     if (z.size() == 0) z = problem.initial_guess();
     else if (v0_before.size()) z = problem.controls().from_initial_velocity(v0_before);
-    else z = problem.controls().remap_from(z, z_time);
+    else z = problem.controls().remap_from(z, z_time, z_from_frame);
     if (z.size() != problem.size())
       throw InputError((dir / "controls.bin").string() + ": holds " + std::to_string(z.size()) +
                        " controls, the scene needs " + std::to_string(problem.size()));
@@ -355,9 +362,12 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     elog.say(std::string(resuming ? "resuming " : "optimising ") + scene.name +
              (stage_id ? " stage " + std::to_string(stage_id) : "") + ": " + job.sys->describe() + ", " +
              std::to_string(time.steps()) + " steps (h = " + std::to_string(time.h()) + " s), " +
-             std::to_string(problem.size()) + " control variables (" + problem.controls().kind() + ")");
+             std::to_string(problem.size()) + " control variables (" + problem.controls().kind() +
+             (problem.controls().first_frame() > 0 ? " from frame " + std::to_string(problem.controls().first_frame()) : "") +
+             ")");
     OptimizerSpec spec = scene.optimizer;
     spec.max_evaluations = stages[s].max_evaluations;
+    if (spec.first_step < 0) spec.first_step = plan.scaled_first_step ? problem.control_scale() : 0;
     Progress progress("optimize " + scene.name, spec.max_evaluations);
     const OptimizeResult res = run_stage(problem, spec, scene.optimizer.restarts, z, stage_id, time.substeps,
                                          job.seconds, elog, progress, job.tape);

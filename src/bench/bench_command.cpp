@@ -96,6 +96,9 @@ void add_solver_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>
                 "IC(0) PCG tolerances of our runs beside Blender's (each run's end state against a 1e-12 solve)")
       ->capture_default_str()->check(CLI::Range(1e-15, 1.0));
   s->add_option("--blender-script", o->solver.blender_script, "the anchor's Blender script")->capture_default_str();
+  s->add_flag("--motion-table,!--no-motion-table", o->solver.motion_table,
+              "the motion table (solver_motion.csv: three 30 x 30 sheets over 2 s against a 1e-12 solve)")
+      ->capture_default_str();
 }
 
 void add_adjoint_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {

@@ -415,6 +415,7 @@ nlohmann::json bench_solver(const SolverSweepOptions& o, const std::filesystem::
   const CsvTable table = resolution_sweep(o, po);
   write_resolution_sweep(o, table, out);
   summary["solver"] = table.excerpt();
+  if (!o.motion_table) return summary;
   const CsvTable motion = motion_tolerance_table(o.motion_tolerances);
   motion.write(out / "solver_motion.csv");
   summary["motion"] = motion.excerpt();

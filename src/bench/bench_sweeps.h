@@ -31,6 +31,7 @@ struct SolverSweepOptions {
   std::vector<double> blender_tolerances{1e-8, 1e-6, 1e-5, 1e-4, 1e-3};
   // Tolerances of the motion table (solver_motion.csv)
   std::vector<double> motion_tolerances{1e-8, 1e-6, 1e-4, 1e-3};
+  bool motion_table = true;  // --no-motion-table clears it (the table takes most of a small sweep's time)
   // The Blender anchor's script, beside the repository (shared/ next to its root); the build sets the root.
   std::filesystem::path blender_script = std::filesystem::path(KEYFRAME_REPOSITORY) / "../shared/anchors/blender/bench.py";
 };

@@ -101,14 +101,22 @@ void Controls::gather(const std::vector<VecX>& dU, const VecX& dv0, VecX& dz) co
   }
 }
 
-VecX Controls::remap_from(const VecX& z, const TimeSpec& from) const {
-  if (kind_ != ControlKind::kPerStep || from.substeps == substeps_) return z;
+VecX Controls::remap_from(const VecX& z, const TimeSpec& from, int from_frame) const {
+  if (kind_ == ControlKind::kInitialVelocity) return z;
+  const int from_first = std::clamp(from_frame, 0, std::max(0, frames_ - 1)) * from.substeps;
+  if (from.substeps == substeps_ && from_first == first_step_) return z;
   const int stride = particles_ * int(comps_.size());
-  VecX out(size());
-  const int from_first = first_step_ / substeps_ * from.substeps;
+  // The earlier controls' block holding step m of their discretisation (-1: none).
+  const auto from_block = [&](int m) {
+    if (m < from_first) return -1;
+    return kind_ == ControlKind::kPerStep ? m - from_first : (m - from_first) / from.substeps;
+  };
+  VecX out = VecX::Zero(size());
   for (int n = first_step_; n < steps_; ++n) {
     const int m = std::min(from.steps() - 1, int((long(n) * from.substeps) / substeps_));
-    out.segment(long(n - first_step_) * stride, stride) = z.segment(long(m - from_first) * stride, stride);
+    const int b = from_block(m);
+    if (b < 0 || long(b + 1) * stride > z.size()) continue;
+    out.segment(long(block_of(n)) * stride, stride) = z.segment(long(b) * stride, stride);
   }
   return out;
 }

@@ -25,9 +25,13 @@ class Controls {
   void expand(const VecX& z, VecX& v0, std::vector<VecX>& U) const;
   // Chain rule back: dphi/dU and dphi/dv0 -> dphi/dz (overwrites dz).
   void gather(const std::vector<VecX>& dU, const VecX& dv0, VecX& dz) const;
-  // Carries controls made for `from` (another substep count) over to this parameterisation: per-frame
-  // and initial-velocity controls are unchanged; per-step forces are held over the nearest coarse step.
-  VecX remap_from(const VecX& z, const TimeSpec& from) const;
+  // Carries controls made for `from` (another substep count) whose forces began at frame `from_frame`
+  // over to this parameterisation: initial-velocity controls are unchanged; per-step forces are held over
+  // the nearest coarse step; frames the earlier controls did not reach get no force, frames they reached
+  // before this one's first frame are dropped (a window grown backwards starts where the last one ended).
+  VecX remap_from(const VecX& z, const TimeSpec& from, int from_frame) const;
+  // The first frame with a force (controls.from_frame, clamped; 0 for initial velocities).
+  int first_frame() const { return first_step_ / substeps_; }
   // One step at a time (no per-step storage): the force of step n (3p, resized here) and the chain
   // rule of one step's dphi/du_n (3p) added into dz (size()). Zero / nothing for initial velocities.
   void force_at(const VecX& z, int n, VecX& u) const;

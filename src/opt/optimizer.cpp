@@ -20,8 +20,32 @@ struct Driver {
 
   int max_evaluations = 0;  // a hard limit (NLopt's own maxeval may run past it); 0: none
   bool limit_reached = false;
+  // NLopt's variables y give the controls z = z0 + scale·y (scale 1: z = y, bit for bit as without it).
+  VecX z0;
+  double scale = 1;
+  // The evaluation at z0 made before NLopt starts, served again when NLopt asks for it first.
+  bool have_first = false;
+  double first_phi = 0;
+  VecX first_g;
 
   double operator()(const std::vector<double>& x, std::vector<double>& grad) {
+    const Eigen::Map<const VecX> y(x.data(), Eigen::Index(x.size()));
+    if (scale == 1) z = y;
+    else z = z0 + scale * y;
+    if (have_first) {
+      have_first = false;
+      if (z == z0) {
+        if (!grad.empty()) Eigen::Map<VecX>(grad.data(), first_g.size()) = scale * first_g;
+        return first_phi;
+      }
+    }
+    const double phi = evaluate(grad.empty() ? nullptr : &g);
+    if (!grad.empty()) Eigen::Map<VecX>(grad.data(), g.size()) = scale * g;
+    return phi;
+  }
+
+  // φ (and dφ/dz into *gz) at z, recorded as one evaluation.
+  double evaluate(VecX* gz) {
     if (stop && stop->load()) {
       result.interrupted = true;
       throw nlopt::forced_stop();
@@ -30,14 +54,13 @@ struct Driver {
       limit_reached = true;
       throw nlopt::forced_stop();
     }
-    z = Eigen::Map<const VecX>(x.data(), Eigen::Index(x.size()));
     g.resize(z.size());
     EvaluationRecord rec;
-    const RecordedEvaluation* replayed = tape && !grad.empty() ? tape->replay(z) : nullptr;
+    const RecordedEvaluation* replayed = tape && gz ? tape->replay(z) : nullptr;
     double phi;
     if (replayed) {
       phi = replayed->phi;
-      g = replayed->g;
+      *gz = replayed->g;
       rec.diverged = replayed->diverged;
       rec.terms = replayed->terms;
       rec.seconds = replayed->seconds;
@@ -45,16 +68,15 @@ struct Driver {
       start = std::chrono::steady_clock::now() - std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                      std::chrono::duration<double>(replayed->seconds));
     } else {
-      phi = problem.evaluate(z, grad.empty() ? nullptr : &g);
+      phi = problem.evaluate(z, gz);
       rec.diverged = problem.last_diverged();
       rec.terms = problem.breakdown();
       rec.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
-    if (!grad.empty()) Eigen::Map<VecX>(grad.data(), g.size()) = g;
-    if (tape && !grad.empty()) tape->record({z, g, phi, rec.seconds, rec.diverged, rec.terms});
+    if (tape && gz) tape->record({z, *gz, phi, rec.seconds, rec.diverged, rec.terms});
     rec.evaluation = ++result.evaluations;
     rec.phi = phi;
-    rec.grad_norm = grad.empty() ? 0 : g.norm();
+    rec.grad_norm = gz ? gz->norm() : 0;
     if (!rec.diverged && phi < result.phi) {
       result.phi = phi;
       result.z = z;
@@ -96,15 +118,33 @@ OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX&
     d(x, g);
     d.result.status = "no optimisation requested";
   } else {
-    nlopt::opt opt(nlopt::LD_LBFGS, n);
-    opt.set_min_objective(&Driver::thunk, &d);
-    opt.set_maxeval(spec.max_evaluations);
-    d.max_evaluations = spec.max_evaluations;
-    if (spec.ftol_rel > 0) opt.set_ftol_rel(spec.ftol_rel);
-    if (spec.max_seconds > 0) opt.set_maxtime(spec.max_seconds);
-    opt.set_vector_storage(unsigned(spec.memory));
+    // NLopt's LD_LBFGS ignores set_initial_step: its first trial step (and the first after each of its
+    // internal restarts) is the whole negative gradient, 1e10 on sensitive cloth. Scaling the variables
+    // uniformly by s makes that step s² times the gradient while L-BFGS's later steps, scaled by their
+    // own curvature estimate, stay as they were; s is chosen so the first trial moves the controls by
+    // first_step RMS per variable, and only when the gradient is steeper than that.
     double f = 0;
     try {
+      const double rms = spec.first_step > 0 ? spec.first_step : 0;  // automatic (< 0) is resolved by the caller
+      if (rms > 0) {
+        d.z = z0;
+        d.first_phi = d.evaluate(&d.g);
+        d.first_g = d.g;
+        d.have_first = !d.result.history.back().diverged;  // a replayed evaluation leaves the problem untouched
+        d.z0 = z0;
+        const double gnorm = d.first_g.norm(), step = rms * std::sqrt(double(n));
+        if (d.have_first && std::isfinite(gnorm) && gnorm > step) {
+          d.scale = std::sqrt(step / gnorm);
+          std::fill(x.begin(), x.end(), 0.0);
+        }
+      }
+      nlopt::opt opt(nlopt::LD_LBFGS, n);
+      opt.set_min_objective(&Driver::thunk, &d);
+      opt.set_maxeval(spec.max_evaluations);
+      d.max_evaluations = spec.max_evaluations;
+      if (spec.ftol_rel > 0) opt.set_ftol_rel(spec.ftol_rel);
+      if (spec.max_seconds > 0) opt.set_maxtime(spec.max_seconds);
+      opt.set_vector_storage(unsigned(spec.memory));
       d.result.status = status_name(opt.optimize(x, f));
     } catch (const nlopt::forced_stop&) {
       d.result.status = "interrupted";

@@ -1,6 +1,7 @@
 #include "opt/problem.h"
 
 #include <cmath>
+#include <string>
 
 namespace kf {
 
@@ -22,6 +23,12 @@ Problem::Problem(const Scene& scene, const TimeSpec& time, System& sys)
     terms_.push_back(make_objective_term(spec, sys.particles()));
     terms_at_step_[spec.frame * time_.substeps].push_back(int(terms_.size()) - 1);
   }
+}
+
+double Problem::control_scale() const {
+  if (std::string(controls_.kind()).rfind("initial", 0) == 0) return 1.0;
+  const VecX& m = sys_.masses();
+  return m.size() ? 9.81 * m.mean() : 1.0;
 }
 
 bool Problem::active(int n) const { return !terms_at_step_[n].empty(); }

@@ -23,6 +23,9 @@ class Problem : public StateCost {
   const TimeSpec& time() const { return time_; }
   System& system() { return sys_; }
   VecX initial_guess() const { return controls_.initial_guess(); }
+  // A physically modest size of one control variable, what an optimiser's first step may change it by:
+  // the mean particle's weight under standard gravity (N) for forces, 1 m/s for initial velocities.
+  double control_scale() const;
 
   // φ(z); when grad is given, also dφ/dz. A simulation that diverges gives a large finite φ that grows
   // away from the last good point (so a line search backs off) and never NaN.

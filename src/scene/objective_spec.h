@@ -105,6 +105,16 @@ struct OptimizerSpec {
   int restarts = 0;
   // Cloth adjoint: "exact" (the transpose of the step's Jacobian) or "swap" (the paper's integrator swap).
   std::string adjoint = "exact";
+  // How the run is split into stages when no schedule is given (opt/windows.h): "auto" keeps every
+  // gradient short on cloth (forces over windows grown backwards from the last keyframe when the gradient
+  // grows across the horizon; a rigid throw before per-particle initial velocities), "single" optimises
+  // the scene's controls in one stage.
+  std::string strategy = "auto";
+  int window_frames = 5;  // the first window's length in frames; each next window is twice as long
+  double window_growth = 1e3;  // windows only when the start's force gradient grows more than this
+  // RMS change per control variable of L-BFGS's first trial step (N for forces, m/s for velocities); a
+  // steeper start is scaled down to it. < 0: automatic (the mean particle's weight, or 1 m/s); 0: off.
+  double first_step = -1;
 };
 
 }  // namespace kf

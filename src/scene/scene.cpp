@@ -145,6 +145,10 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls) {
   o.checkpoint_every = b.integer("checkpoint_every", o.checkpoint_every, 0, 10'000'000);
   o.restarts = b.integer("restarts", o.restarts, 0, 1000);
   o.adjoint = b.string("adjoint", o.adjoint, {"exact", "swap"});
+  o.strategy = b.string("strategy", o.strategy, {"auto", "single"});
+  o.window_frames = b.integer("window_frames", o.window_frames, 1, 1'000'000);
+  o.window_growth = b.number("window_growth", o.window_growth, 1.0, 1e300);
+  if (b.has("first_step")) o.first_step = b.number("first_step", 0.0, 0.0, 1e12);
   b.finish();
   return o;
 }

@@ -102,7 +102,7 @@ TEST_F(GradcheckBenchCli, TinyFlockBenchWritesItsCsvPlotAndSummary) {
 TEST_F(GradcheckBenchCli, TinySolverBenchHasAColumnPerSolverAndRefusesUnknownNames) {
   const auto r = run_keyframe(
       "bench --only solver --solver-resolutions 6,8 --solvers pcg,mg-1e-6,auto,direct --threads 1 --solver-frames 1 "
-      "--blender-n 0 --out s",
+      "--blender-n 0 --no-motion-table --out s",
       dir_);
   ASSERT_EQ(r.code, kExitOk) << r.output;
   std::ifstream csv(dir_ / "s/solver.csv");
@@ -121,6 +121,7 @@ TEST_F(GradcheckBenchCli, TinySolverBenchHasAColumnPerSolverAndRefusesUnknownNam
       if (c >= 2) EXPECT_GT(std::stod(cell), 0) << line;
   }
   EXPECT_EQ(rows, 2);
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "s/solver_motion.csv"));
   for (const char* bad : {"mg-2", "ilu", "pcg-x"}) {
     const auto b = run_keyframe(std::string("bench --only solver --solvers ") + bad + " --out t", dir_);
     EXPECT_NE(b.code, kExitOk) << bad;

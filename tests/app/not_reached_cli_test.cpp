@@ -39,11 +39,14 @@ TEST_F(NotReached, FlagReleasedFlatInItsPlaneIsANoisyStart) {
   EXPECT_GT(report_.at("sensitivity").at("objective_relative_noise_start").get<double>(), 1e-6);
   ASSERT_EQ(report_.at("keyframe_errors").size(), 1u);
   EXPECT_FALSE(report_.at("keyframe_errors")[0].at("met").get<bool>());
-  ASSERT_EQ(report_.at("stage_results").size(), 1u);
-  const auto& stage = report_.at("stage_results")[0];
-  EXPECT_EQ(stage.at("kind"), "per_frame");
-  EXPECT_GT(stage.at("evaluations").get<int>(), 0);
-  EXPECT_TRUE(stage.at("objective_start").is_number() && stage.at("objective_end").is_number());
+  // The default strategy steers this sensitive sheet in windows grown back from the keyframe: a stage each.
+  const auto& stages = report_.at("stage_results");
+  ASSERT_GE(stages.size(), 1u);
+  EXPECT_GT(stages[0].at("evaluations").get<int>(), 0) << stages.dump();
+  for (const auto& stage : stages) {
+    EXPECT_FALSE(stage.at("kind").get<std::string>().empty()) << stages.dump();
+    EXPECT_TRUE(stage.at("objective_start").is_number() && stage.at("objective_end").is_number()) << stages.dump();
+  }
 }
 
 TEST_F(NotReached, FlagWithASmallOutOfPlaneStartIsNotNoisy) {

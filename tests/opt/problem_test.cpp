@@ -87,13 +87,39 @@ TEST(Problem, ForcesFromAFrameOnAreZeroBeforeItAndTheirGradientIsExact) {
   const Controls cf(spec, fine, 1, false, VecX::Zero(3), VecX::Zero(3));
   const Controls cc(spec, coarse, 1, false, VecX::Zero(3), VecX::Zero(3));
   const VecX zc = VecX::LinSpaced(cc.size(), 1, double(cc.size()));
-  const VecX zf = cf.remap_from(zc, coarse);
+  const VecX zf = cf.remap_from(zc, coarse, 5);
   ASSERT_EQ(zf.size(), cf.size());
   VecX uf, uc;
   for (int n = 20; n < 48; ++n) {  // fine step n lies in coarse step n / 2
     cf.force_at(zf, n, uf);
     cc.force_at(zc, n / 2, uc);
     EXPECT_EQ(uf, uc) << "step " << n;
+  }
+}
+
+// A window grown backwards: the forces of the later window carry over unchanged, the new frames start
+// without force; and back again (a shorter window keeps the forces of its own frames).
+TEST(Problem, RemapBetweenWindowsKeepsEachFramesForce) {
+  TimeSpec t;
+  t.fps = 10, t.substeps = 2, t.frames = 12;
+  for (ControlKind kind : {ControlKind::kPerStep, ControlKind::kPerFrame}) {
+    ControlSpec late, early;
+    late.kind = early.kind = kind;
+    late.from_frame = 8;
+    early.from_frame = 3;
+    const Controls cl(late, t, 2, false, VecX::Zero(6), VecX::Zero(6));
+    const Controls ce(early, t, 2, false, VecX::Zero(6), VecX::Zero(6));
+    const VecX zl = VecX::LinSpaced(cl.size(), 1, double(cl.size()));
+    const VecX ze = ce.remap_from(zl, t, 8);
+    ASSERT_EQ(ze.size(), ce.size());
+    VecX ue, ul;
+    for (int n = 0; n < t.steps(); ++n) {
+      ce.force_at(ze, n, ue);
+      cl.force_at(zl, n, ul);
+      EXPECT_EQ(ue, ul) << control_kind_name(kind) << " step " << n;
+    }
+    const VecX back = cl.remap_from(ze, t, 3);
+    EXPECT_EQ(back, zl) << control_kind_name(kind);
   }
 }
 
@@ -149,6 +175,7 @@ TEST(Optimizer, RecoversFromDivergedTrialSteps) {
   EXPECT_FALSE(problem.last_diverged());
   OptimizerSpec spec;
   spec.max_evaluations = 150;
+  spec.first_step = 0;  // NLopt's own first step, the whole gradient: it crosses the limit
   int diverged = 0;
   const OptimizeResult r = minimize(problem, spec, z0, [&](const EvaluationRecord& e) { diverged += e.diverged; });
   EXPECT_TRUE(std::isfinite(r.phi));

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 
+#include "app/optimize_job.h"
 #include "cli_harness.h"
 #include "core/error.h"
 
@@ -67,7 +68,9 @@ TEST_P(ResumeEquivalence, InterruptedAndResumedEqualsUninterrupted) {
     all.insert(all.end(), common.begin(), common.end());
     return all;
   };
-  ASSERT_EQ(run_and_signal(dir_, args({"optimize", scene, "--out", "whole"})), 0);
+  // A budget of 12 may stop short of the keyframes (kExitNotReached): the resumed run must end the same way.
+  const int whole_code = run_and_signal(dir_, args({"optimize", scene, "--out", "whole"}));
+  ASSERT_TRUE(whole_code == 0 || whole_code == kExitNotReached) << whole_code;
   ASSERT_EQ(run_and_signal(dir_, args({"optimize", scene, "--out", "cut"}), 5), kExitInterrupted);
   const auto cut = report_of(dir_ / "cut");
   EXPECT_TRUE(cut.at("interrupted").get<bool>());
@@ -75,7 +78,7 @@ TEST_P(ResumeEquivalence, InterruptedAndResumedEqualsUninterrupted) {
   const int done = cut.at("evaluations").get<int>();
   EXPECT_GE(done, 5);
   EXPECT_LT(done, 12);
-  ASSERT_EQ(run_and_signal(dir_, args({"optimize", "--resume", "cut"})), 0);
+  ASSERT_EQ(run_and_signal(dir_, args({"optimize", "--resume", "cut"})), whole_code);
   const auto whole = report_of(dir_ / "whole"), resumed = report_of(dir_ / "cut");
   EXPECT_EQ(resumed.at("replayed_evaluations").get<int>(), done);
   EXPECT_EQ(resumed.at("evaluations"), whole.at("evaluations"));
@@ -101,7 +104,8 @@ TEST_P(StopSignals, SaveTheRunAndSayInterrupted) {
   EXPECT_EQ(r.at("status").get<std::string>(), "interrupted");
   for (const char* f : {"controls.bin", "trajectory.bin", "evaluations.bin", "iterations.csv", "scene.json"})
     EXPECT_TRUE(fs::exists(dir_ / "run" / f)) << f;
-  EXPECT_EQ(run_and_signal(dir_, {"optimize", "--resume", "run", "--max-evaluations", "4"}), 0);
+  // Four evaluations do not reach the keyframe: the resumed run is written and says so.
+  EXPECT_EQ(run_and_signal(dir_, {"optimize", "--resume", "run", "--max-evaluations", "4"}), kExitNotReached);
 }
 
 INSTANTIATE_TEST_SUITE_P(Signals, StopSignals, ::testing::Values(SIGINT, SIGTERM, SIGHUP, SIGQUIT),
@@ -111,7 +115,7 @@ class EvaluationLimit : public TempDirTest, public ::testing::WithParamInterface
 
 TEST_P(EvaluationLimit, MaxEvaluationsIsAHardLimit) {
   const std::string scene = std::string(KEYFRAME_SOURCE_DIR) + "/scenes/" + GetParam() + ".json";
-  ASSERT_EQ(run_and_signal(dir_, {"optimize", scene, "--out", "run", "--max-evaluations", "3"}), 0);
+  ASSERT_EQ(run_and_signal(dir_, {"optimize", scene, "--out", "run", "--max-evaluations", "3"}), kExitNotReached);
   const auto r = report_of(dir_ / "run");
   EXPECT_EQ(r.at("evaluations").get<int>(), 3);
   EXPECT_EQ(r.at("status").get<std::string>(), "evaluation limit reached");

@@ -16,6 +16,7 @@
 #include "sim/character/cape_anchors.h"
 #include "sim/make_system.h"
 #include "character_test_util.h"
+#include "gradient_test_helpers.h"
 
 namespace kf {
 namespace {
@@ -78,15 +79,7 @@ TEST(CapeSystem, SceneErrorsNameTheKey) {
   EXPECT_THROW(parse_scene(s, "bad.json"), InputError);
 }
 
-struct EndTarget : StateCost {
-  int last;
-  VecX target;
-  bool active(int n) const override { return n == last; }
-  double eval(int, const VecX& x, const VecX&, VecX& gx, VecX&) const override {
-    gx += x - target;
-    return 0.5 * (x - target).squaredNorm();
-  }
-};
+using test::EndTarget;
 
 struct Agreement {
   double cosine, relative_error, body_contacts, self_contacts;
@@ -214,12 +207,7 @@ TEST(CapeSystem, GradcheckWithBodyAndSelfContactsAtEveryStepAndPerturbation) {
     const Scene scene = parse_scene(text, "cape-gradcheck.json");
     auto sys = make_system(scene);
     Problem problem(scene, scene.time, *sys);
-    for (double perturb : {0.0, 0.01, 0.1}) {
-      VecX z = problem.initial_guess();
-      std::mt19937_64 rng(3);
-      std::normal_distribution<double> normal(0.0, perturb);
-      for (int i = 0; i < z.size(); ++i) z[i] += normal(rng);
-      const GradcheckResult r = gradcheck(problem, z, {.samples = 16, .eps = 1e-4, .seed = 5});
+    test::gradcheck_perturbed(problem, 1e-4, {0.0, 0.01, 0.1}, [&](double perturb, const GradcheckResult& r) {
       const auto stats = sys->run_stats();
       std::printf("h = 1/%d, perturb %g: max_rel_error %.2e, fd_spread %.2e, %d checked, %d kinks, %g body, %g "
                   "self contacts\n",
@@ -229,7 +217,7 @@ TEST(CapeSystem, GradcheckWithBodyAndSelfContactsAtEveryStepAndPerturbation) {
       EXPECT_GT(stats[1].second, 0) << "no self contact: the check would not cover it";
       EXPECT_GE(r.checked, 14) << "h = 1/" << 30 * substeps << " perturb " << perturb;
       EXPECT_LE(r.max_rel_error, 1e-6) << "h = 1/" << 30 * substeps << " perturb " << perturb;
-    }
+    });
   }
 }
 

@@ -6,13 +6,13 @@
 
 #include <cmath>
 #include <cstdio>
-#include <random>
 #include <string>
 
 #include "opt/gradcheck.h"
 #include "opt/problem.h"
 #include "scene/scene.h"
 #include "sim/make_system.h"
+#include "gradient_test_helpers.h"
 
 namespace kf {
 namespace {
@@ -96,18 +96,13 @@ TEST_P(ClothExactAdjoint, MatchesFiniteDifferencesAtEveryStepAndPerturbation) {
     const Scene scene = scene_of(c, substeps);
     auto sys = make_system(scene);
     Problem problem(scene, scene.time, *sys);
-    for (double perturb : {0.0, 0.01, 0.1}) {
-      VecX z = problem.initial_guess();
-      std::mt19937_64 rng(3);
-      std::normal_distribution<double> normal(0.0, perturb);
-      for (int i = 0; i < z.size(); ++i) z[i] += normal(rng);
-      const GradcheckResult r = gradcheck(problem, z, {.samples = 16, .eps = c.eps, .seed = 5});
+    test::gradcheck_perturbed(problem, c.eps, {0.0, 0.01, 0.1}, [&](double perturb, const GradcheckResult& r) {
       std::printf("%s h = 1/%d, perturb %g: max_rel_error %.2e, fd_spread %.2e, %d checked, %d kinks\n", c.name,
                   30 * substeps, perturb, r.max_rel_error, r.fd_spread, r.checked, r.kinks);
       ASSERT_GT(r.grad_norm, 0) << c.name;
       EXPECT_GE(r.checked, std::min(14, problem.size())) << c.name << " h = 1/" << 30 * substeps;
       EXPECT_LE(r.max_rel_error, 1e-6) << c.name << " h = 1/" << 30 * substeps << " perturb " << perturb;
-    }
+    });
   }
 }
 

@@ -6,9 +6,11 @@
 #include <random>
 
 #include "scene/cloth_spec.h"
-#include "sim/cloth/air_drag.h"
+#include "sim/cloth/air_drag_term.h"
 #include "sim/cloth/buckling_spring.h"
+#include "sim/cloth/cloth_terms.h"
 #include "sim/cloth/spring_damping.h"
+#include "cloth_term_check.h"
 
 namespace kf {
 namespace {
@@ -353,6 +355,83 @@ TEST(ClothAirDrag, JacobianMatchesFiniteDifferences) {
   }
   ASSERT_GT(fd.norm(), 0);
   EXPECT_LT(relative_error(air_drag_jacobian_v(c, m), fd), 1e-8);
+}
+
+}  // namespace
+}  // namespace kf
+
+// Every term of the cloth's list through the one check of tests/sim/cloth_term_check.h: energy gradient,
+// definite blocks, and the exact adjoint's shares against central differences at two step sizes, on
+// compressed, stretched and contact states of a small sheet.
+namespace kf {
+namespace {
+
+const char* kSheet = R"({"nx": 4, "ny": 4, "width": 0.3, "height": 0.3, "mass": 0.1, "damping": 0.3,
+                         "air_drag": 0.5, "origin": [-0.15, 0.02, -0.15], "v_axis": [0, 0, 1]})";
+
+TEST(ClothForces, GravityTermIsMinusItsEnergyGradientAndHasNoAdjointShare) {
+  const auto sheet = test::term_sheet(kSheet);
+  VecX x, v;
+  test::perturbed_state(*sheet, 0.9, 0.005, 0.3, 1, x, v);
+  const test::TermCheck c = test::check_term(test::TermProbe<GravityTerm>(*sheet), x, v, 2);
+  EXPECT_GT(c.force, 0);
+  EXPECT_GT(c.energy_gradient, 0);
+}
+
+TEST(ClothForces, AirDragTermsDampingBlockIsItsExactVelocityJacobian) {
+  const auto sheet = test::term_sheet(kSheet);
+  VecX x, v;
+  test::perturbed_state(*sheet, 0.9, 0.005, 0.3, 3, x, v);
+  const test::TermCheck c = test::check_term(test::TermProbe<AirDragTerm>(*sheet), x, v, 4);
+  EXPECT_GT(c.force, 0);
+}
+
+TEST(ClothForces, SpringTermMatchesFiniteDifferencesCompressedAndStretched) {
+  const auto sheet = test::term_sheet(kSheet);
+  for (double squeeze : {0.8, 0.97, 1.06}) {
+    SCOPED_TRACE(squeeze);
+    VecX x, v;
+    test::perturbed_state(*sheet, squeeze, 0.004, 0.3, 5, x, v);
+    const test::TermCheck c = test::check_term(test::TermProbe<SpringTerm>(*sheet), x, v, 6);
+    EXPECT_GT(c.energy_gradient, 0);
+    EXPECT_GT(c.adjoint_x, 0);
+  }
+}
+
+TEST(ClothForces, SpringDampingTermMatchesFiniteDifferencesCompressedAndStretched) {
+  const auto sheet = test::term_sheet(kSheet);
+  for (double squeeze : {0.8, 1.06}) {
+    SCOPED_TRACE(squeeze);
+    VecX x, v;
+    test::perturbed_state(*sheet, squeeze, 0.004, 0.5, 7, x, v);
+    const test::TermCheck c = test::check_term(test::TermProbe<SpringDampingTerm>(*sheet), x, v, 8);
+    EXPECT_GT(c.force, 0);
+    EXPECT_GT(c.adjoint_x, 0);
+  }
+}
+
+// The sheet lies within the contact thickness of each collider (ground, sphere, torus, capsule).
+TEST(ClothForces, ContactTermMatchesFiniteDifferencesInContact) {
+  const char* colliders[] = {
+      R"({"type": "ground", "center": [0, 0, 0], "axis": [0, 1, 0], "thickness": 0.03, "stiffness": 3000})",
+      R"({"type": "sphere", "center": [0, -0.2, 0], "radius": 0.21, "thickness": 0.03, "stiffness": 3000})",
+      R"({"type": "torus", "center": [0, -0.02, 0], "axis": [0, 1, 0], "radius": 0.12, "tube_radius": 0.03,
+          "thickness": 0.03, "stiffness": 3000})",
+      R"({"type": "capsule", "a": [-0.2, -0.005, 0], "b": [0.2, -0.005, 0], "radius": 0.03, "thickness": 0.03,
+          "stiffness": 3000})",
+  };
+  for (const char* col : colliders) {
+    SCOPED_TRACE(col);
+    std::string cloth = kSheet;
+    cloth.insert(cloth.rfind('}'), std::string(R"(, "colliders": [)") + col + "]");
+    const auto sheet = test::term_sheet(cloth);
+    VecX x, v;
+    test::perturbed_state(*sheet, 0.95, 0.004, 0.3, 9, x, v);
+    const test::TermCheck c = test::check_term(test::TermProbe<ContactTerm>(*sheet), x, v, 10);
+    EXPECT_GT(c.force, 0) << "no contact: the check would not cover it";
+    EXPECT_GT(c.energy_gradient, 0);
+    EXPECT_GT(c.adjoint_x, 0);
+  }
 }
 
 }  // namespace

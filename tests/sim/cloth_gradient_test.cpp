@@ -15,21 +15,14 @@
 #include "scene/scene.h"
 #include "sim/cloth/cloth_system.h"
 #include "sim/make_system.h"
+#include "gradient_test_helpers.h"
 
 namespace kf {
 namespace {
 
 constexpr double kDuration = 40.0 / 60.0;  // seconds, the same for every step size
 
-struct EndTarget : StateCost {
-  int last;
-  VecX target;
-  bool active(int n) const override { return n == last; }
-  double eval(int, const VecX& x, const VecX&, VecX& gx, VecX&) const override {
-    gx += x - target;
-    return 0.5 * (x - target).squaredNorm();
-  }
-};
+using test::EndTarget;
 
 struct Study {
   double cosine, relative_error;

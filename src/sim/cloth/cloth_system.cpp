@@ -9,23 +9,12 @@
 #include <tbb/partitioner.h>
 
 #include "core/error.h"
-#include "sim/cloth/air_drag.h"
-#include "sim/cloth/gravity.h"
 #include "sim/cloth/imperfection.h"
-#include "sim/cloth/spring_damping.h"
 #include "sim/make_system.h"
 
 namespace kf {
 
 namespace {
-// Grain sizes: below these a parallel loop costs more than it saves on two cores. Loops over particles
-// use TBB's static partitioner, as the PCG's do, so each thread gets the same particles in every loop and
-// their data stays in its core's cache: with TBB's default partitioner some processes ran the 50 x 50 step
-// on two threads 40 % slower than others. Loops over springs do not: springs are ordered by kind, so a
-// static share of them spans the whole sheet (measured slower).
-constexpr int kSpringGrain = 1024;
-constexpr int kParticleGrain = 256;
-
 // "auto": IC(0) below this many particles, where its two-halves order makes it the cheapest CG
 // preconditioner here on one and two threads; multigrid from there on, where IC(0)'s iteration count (which
 // grows with the sheet's side while multigrid's stays flat) has caught up with it: at 100 x 100 IC(0) is
@@ -55,71 +44,35 @@ AdjointKind adjoint_kind(const std::string& name) {
   throw std::invalid_argument("unknown adjoint \"" + name + "\" (expected exact or swap)");
 }
 
+namespace {
+// The grid's positions at rest (3p, metres).
+VecX rest_positions(const ClothSpec& spec) {
+  const double dx = spec.width / (spec.nx - 1), dy = spec.height / (spec.ny - 1);
+  VecX x0(3 * spec.particles());
+  for (int j = 0; j < spec.ny; ++j)
+    for (int i = 0; i < spec.nx; ++i) seg(x0, spec.index(i, j)) = spec.origin + i * dx * spec.u_axis + j * dy * spec.v_axis;
+  add_imperfection(x0, spec.u_axis.cross(spec.v_axis), spec.imperfection, uint64_t(spec.imperfection_seed));
+  return x0;
+}
+
+std::vector<std::unique_ptr<Collider>> all_colliders(const ClothSpec& spec,
+                                                     std::vector<std::unique_ptr<Collider>> extra) {
+  std::vector<std::unique_ptr<Collider>> out = make_colliders(spec.colliders, spec.contact_ramp);
+  for (auto& c : extra) out.push_back(std::move(c));
+  return out;
+}
+}  // namespace
+
 ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTrack> pins,
                          std::vector<std::unique_ptr<Collider>> extra_colliders)
-    : spec_(spec), p_(spec.particles()), h_(h), pins_(pins ? std::move(pins) : std::make_unique<StaticPins>()) {
-  const int nx = spec.nx, ny = spec.ny;
-  const double dx = spec.width / (nx - 1), dy = spec.height / (ny - 1);
+    : spec_(spec),
+      p_(spec.particles()),
+      h_(h),
+      x0_(rest_positions(spec)),
+      colliders_(all_colliders(spec, std::move(extra_colliders))),
+      assembly_(spec, x0_, colliders_),
+      pins_(pins ? std::move(pins) : std::make_unique<StaticPins>()) {
   mass_.setConstant(p_, spec.mass / p_);
-  x0_.resize(3 * p_);
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) seg(x0_, spec.index(i, j)) = spec.origin + i * dx * spec.u_axis + j * dy * spec.v_axis;
-  add_imperfection(x0_, spec.u_axis.cross(spec.v_axis), spec.imperfection, uint64_t(spec.imperfection_seed));
-
-  auto add = [&](int a, int b, double k) {
-    BucklingSpring s;
-    s.a = a;
-    s.b = b;
-    s.rest = (seg(x0_, b) - seg(x0_, a)).norm();
-    s.k = k;
-    s.k_post = spec.buckle_stiffness * k;
-    s.f_buckle = k * s.rest * spec.buckle_strain;
-    s.transverse_ramp = spec.transverse_ramp;
-    springs_.push_back(s);
-  };
-  // Type 1 (damped): structural, then shear.
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      if (i + 1 < nx) add(spec.index(i, j), spec.index(i + 1, j), spec.stretch);
-      if (j + 1 < ny) add(spec.index(i, j), spec.index(i, j + 1), spec.stretch);
-    }
-  for (int j = 0; j + 1 < ny; ++j)
-    for (int i = 0; i + 1 < nx; ++i) {
-      add(spec.index(i, j), spec.index(i + 1, j + 1), spec.shear);
-      add(spec.index(i + 1, j), spec.index(i, j + 1), spec.shear);
-    }
-  damped_ = int(springs_.size());
-  // Type 2: bending across two edges.
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      if (i + 2 < nx) add(spec.index(i, j), spec.index(i + 2, j), spec.bend);
-      if (j + 2 < ny) add(spec.index(i, j), spec.index(i, j + 2), spec.bend);
-    }
-
-  std::vector<std::vector<int>> cols(p_);
-  for (int i = 0; i < p_; ++i) cols[i].push_back(i);
-  for (const BucklingSpring& s : springs_) {
-    cols[s.a].push_back(s.b);
-    cols[s.b].push_back(s.a);
-  }
-  A_.set_pattern(cols);
-  std::vector<std::vector<Incident>> inc(p_);
-  for (int k = 0; k < int(springs_.size()); ++k) {
-    const BucklingSpring& s = springs_[k];
-    inc[s.a].push_back({k, +1, A_.find(s.a, s.b)});
-    inc[s.b].push_back({k, -1, A_.find(s.b, s.a)});
-  }
-  slot_spring_.assign(A_.nonzero_blocks(), -1);
-  for (const auto& list : inc)
-    for (const Incident& in : list) slot_spring_[in.slot] = in.spring;
-  incident_start_.assign(1, 0);
-  for (auto& list : inc) {
-    incident_.insert(incident_.end(), list.begin(), list.end());
-    incident_start_.push_back(int(incident_.size()));
-  }
-
-  colliders_ = make_colliders(spec.colliders, spec.contact_ramp);
-  for (auto& c : extra_colliders) colliders_.push_back(std::move(c));
   free_.assign(p_, 1);
   for (int i : spec.pins) {
     if (i < 0 || i >= p_) throw InputError("cloth: pinned particle " + std::to_string(i) + " does not exist");
@@ -127,22 +80,12 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   }
   for (int i = 0; i < p_; ++i)
     if (!free_[i]) pinned_list_.push_back(i);
-  for (int k = 0; k < int(springs_.size()); ++k)
-    if (!free_[springs_[k].a] || !free_[springs_[k].b]) pinned_springs_.push_back(k);
-
-  spring_f_.assign(springs_.size(), Vec3::Zero());
-  energy_parts_.assign((springs_.size() + kSpringGrain - 1) / kSpringGrain, 0.0);
-  spring_K_.assign(springs_.size(), Mat3::Zero());
-  spring_state_.assign(springs_.size(), SpringState());
-  spring_D_.assign(springs_.size(), Mat3::Zero());
-  force_.setZero(3 * p_);
+  const auto& springs = assembly_.springs().list;
+  for (int k = 0; k < int(springs.size()); ++k)
+    if (!free_[springs[k].a] || !free_[springs[k].b]) pinned_springs_.push_back(k);
   rhs_.setZero(3 * p_);
   dv_.setZero(3 * p_);
   forward_start_.resize(3 * p_);
-  contact_K_.assign(p_, Mat3::Zero());
-  diag_K_.assign(p_, Mat3::Zero());
-  diag_D_.assign(p_, Mat3::Zero());
-  aw_.setZero(3 * p_);
   w_.setZero(3 * p_);
   adjoint_start_.resize(3 * p_);
   solved_x_.setZero(3 * p_);
@@ -155,9 +98,7 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   // IC(0) leaves out the bending springs' blocks: with the default stiffnesses they are a hundredth of the
   // stretch springs' and they reach two grid rows, so they made half the factor's blocks and a separator twice
   // as wide for a few per cent fewer iterations.
-  std::vector<char> keep(A_.nonzero_blocks());
-  for (int s = 0; s < A_.nonzero_blocks(); ++s) keep[s] = slot_spring_[s] < damped_;  // the diagonal is -1
-  pcg_.set_factor_pattern(std::move(keep));
+  pcg_.set_factor_pattern(assembly_.factor_pattern());
 }
 
 void ClothSystem::initial_state(VecX& x, VecX& v) const {
@@ -173,60 +114,9 @@ void ClothSystem::initial_state(VecX& x, VecX& v) const {
 }
 
 void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs, bool forces) {
-  const int ns = int(springs_.size());
-  // Each spring writes only its own slots.
-  tbb::parallel_for(tbb::blocked_range<int>(0, ns, kSpringGrain), [&](const tbb::blocked_range<int>& r) {
-    for (int k = r.begin(); k < r.end(); ++k) {
-      const BucklingSpring& s = springs_[k];
-      spring_force_and_definite_jacobian(s, x, spring_f_[k], spring_K_[k], spring_state_[k]);
-      if (k < damped_) {
-        if (forces) spring_f_[k] += damping_force(s, spec_.damping, spring_state_[k], v);
-        spring_D_[k] = damping_jacobian_v(s, spec_.damping, spring_state_[k]);
-      }
-    }
-  });
-  // Each particle gathers its own row in a fixed order.
-  const double h = hs > 0 ? hs : h_;
-  tbb::parallel_for(tbb::blocked_range<int>(0, p_, kParticleGrain), [&](const tbb::blocked_range<int>& r) {
-    for (int i = r.begin(); i < r.end(); ++i) {
-      const double m = mass_[i];
-      Vec3 f = gravity_force(m, spec_.gravity) + air_drag_force(spec_.air_drag, m, seg(v, i));
-      Mat3 Kii = Mat3::Zero(), Dii = air_drag_jacobian_v(spec_.air_drag, m);
-      // A's off-diagonal blocks are the springs' own (one spring per particle pair): K and D are never
-      // stored as matrices, which keeps a 100 x 100 sheet's working set in cache.
-      for (int e = incident_start_[i]; e < incident_start_[i + 1]; ++e) {
-        const Incident& in = incident_[e];
-        const Mat3& Ks = spring_K_[in.spring];
-        if (forces) f += in.sign * spring_f_[in.spring];
-        Kii -= Ks;
-        if (in.spring < damped_) {
-          const Mat3& Ds = spring_D_[in.spring];
-          A_.block(in.slot) = -h * Ds - h * h * Ks;
-          Dii -= Ds;
-        } else {
-          A_.block(in.slot) = -h * Mat3::Zero() - h * h * Ks;
-        }
-      }
-      ContactForce c;
-      Mat3& Kc = contact_K_[i];
-      Kc.setZero();
-      for (const auto& col : colliders_)
-        if (col->contact(n, seg(x, i), seg(v, i), /*definite=*/true, c)) {
-          f += c.f;
-          Kc += c.dfdx;
-          Dii += c.dfdv;
-        }
-      Kii += Kc;
-      diag_K_[i] = Kii;
-      diag_D_[i] = Dii;
-      seg(force_, i) = f;
-      const int d = A_.diag_slot(i);
-      A_.block(d) = -h * Dii - h * h * Kii;
-      A_.block(d) += m * Mat3::Identity();
-    }
-  }, tbb::static_partitioner());
-  if (direct_solve_) direct_ok_ = direct_.factor(A_, free_);
-  else pcg_.prepare(A_, free_);
+  assembly_.assemble(ClothState{n, x, v, mass_, free_}, hs > 0 ? hs : h_, forces);
+  if (direct_solve_) direct_ok_ = direct_.factor(assembly_.matrix(), free_);
+  else pcg_.prepare(assembly_.matrix(), free_);
 }
 
 bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u,
@@ -238,10 +128,10 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
   const double theta = spec_.theta, hs = theta * h, inv_theta = 1 / theta;
   const bool kick = spec_.explicit_controls();  // u added after the solve, not in b
   assemble(n, x, v, hs);
-  tbb::parallel_for(tbb::blocked_range<int>(0, p_, kParticleGrain), [&](const tbb::blocked_range<int>& r) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, p_, kClothParticleGrain), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i) {
       const Vec3 ui = kick ? Vec3::Zero() : Vec3(seg(u, i));
-      seg(rhs_, i) = hs * (seg(force_, i) + hs * stiffness_times_velocity(i, v) + ui);
+      seg(rhs_, i) = hs * (seg(assembly_.force(), i) + hs * assembly_.stiffness_times_velocity(i, v) + ui);
     }
   }, tbb::static_partitioner());
   // Substeps start cold, so a split step depends on its inputs only.
@@ -262,7 +152,7 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
   v_next.resize(3 * p_);
   x_next.resize(3 * p_);
   // dv_ stays the solve's part: the record's dv, which the adjoint's A(x) dv terms need.
-  tbb::parallel_for(tbb::blocked_range<int>(0, p_, kParticleGrain), [&](const tbb::blocked_range<int>& r) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, p_, kClothParticleGrain), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i) {
       const Vec3 push = kick && free_[i] ? Vec3((h / mass_[i]) * seg(u, i)) : Vec3::Zero();
       seg(v_next, i) = seg(v, i) + inv_theta * seg(dv_, i) + push;
@@ -272,46 +162,20 @@ bool ClothSystem::linear_step(int n, int depth, double t0, const VecX& x, const 
   return res.converged && x_next.allFinite() && v_next.allFinite();
 }
 
-// Row i of K v, with the springs' part in velocity differences: K's rows sum to the contact stiffness
-// alone, so a sheet moving as a whole gives exactly no spring term instead of the round-off of large
-// cancelling products (which shifted the whole sheet by thousands of ulps per step and set the noise
-// floor of finite-difference checks).
-Vec3 ClothSystem::stiffness_times_velocity(int i, const VecX& v) const {
-  const Vec3 vi = seg(v, i);
-  Vec3 kv = contact_K_[i] * vi;
-  for (int k = A_.row_start(i); k < A_.row_start(i + 1); ++k)
-    if (A_.col(k) != i) kv.noalias() += spring_K_[slot_spring_[k]] * (seg(v, A_.col(k)) - vi);
-  return kv;
-}
-
 ClothSystem::Energy ClothSystem::energy(int n, const VecX& x, const VecX& v) const {
-  return with_contact_energy(n, x, state_energy(x, v));
+  return with_contact_energy(n, x, v, state_energy(x, v));
 }
 
-ClothSystem::Energy ClothSystem::with_contact_energy(int n, const VecX& x, Energy e) const {
-  for (int i = 0; i < p_; ++i)
-    for (const auto& c : colliders_) e.contact += c->energy(n, seg(x, i));
+ClothSystem::Energy ClothSystem::with_contact_energy(int n, const VecX& x, const VecX& v, Energy e) const {
+  assembly_.add_energy(ClothState{n, x, v, mass_, free_}, /*contact=*/true, e);
   return e;
 }
 
 ClothSystem::Energy ClothSystem::state_energy(const VecX& x, const VecX& v) const {
   Energy e;
-  for (int i = 0; i < p_; ++i) {
-    if (!free_[i]) continue;
-    e.kinetic += 0.5 * mass_[i] * seg(v, i).squaredNorm();
-    e.gravity -= mass_[i] * spec_.gravity.dot(seg(x, i));
-  }
-  // Springs in fixed chunks summed in chunk order: the same sum on any thread count.
-  const int ns = int(springs_.size()), chunks = (ns + kSpringGrain - 1) / kSpringGrain;
-  double* parts = energy_parts_.data();  // sized for every chunk at construction
-  tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), [&](const tbb::blocked_range<int>& r) {
-    for (int c = r.begin(); c < r.end(); ++c) {
-      double sum = 0;
-      for (int k = c * kSpringGrain; k < std::min(ns, (c + 1) * kSpringGrain); ++k) sum += spring_energy(springs_[k], x);
-      parts[c] = sum;
-    }
-  });
-  for (int c = 0; c < chunks; ++c) e.elastic += parts[c];
+  for (int i = 0; i < p_; ++i)
+    if (free_[i]) e.kinetic += 0.5 * mass_[i] * seg(v, i).squaredNorm();
+  assembly_.add_energy(ClothState{0, x, v, mass_, free_}, /*contact=*/false, e);
   return e;
 }
 
@@ -321,7 +185,7 @@ ClothSystem::Energy ClothSystem::state_energy(const VecX& x, const VecX& v) cons
 // always recomputed.
 ClothSystem::Energy ClothSystem::energy_at_start(int n, const VecX& x, const VecX& v) {
   const bool cached = energy_x_.size() == x.size() && energy_x_ == x && energy_v_ == v;
-  return with_contact_energy(n, x, cached ? cached_energy_ : state_energy(x, v));
+  return with_contact_energy(n, x, v, cached ? cached_energy_ : state_energy(x, v));
 }
 
 void ClothSystem::remember_energy(const VecX& x, const VecX& v, const Energy& e) {
@@ -332,9 +196,10 @@ void ClothSystem::remember_energy(const VecX& x, const VecX& v, const Energy& e)
 }
 
 PcgResult ClothSystem::solve(const VecX& b, VecX& x, bool warm) {
-  if (!direct_solve_) return pcg_.solve(A_, free_, b, x, spec_.cg_tolerance, spec_.cg_max_iterations, warm);
+  const BlockSparse3& A = assembly_.matrix();
+  if (!direct_solve_) return pcg_.solve(A, free_, b, x, spec_.cg_tolerance, spec_.cg_max_iterations, warm);
   PcgResult r;
-  r.converged = direct_ok_ && direct_.solve(A_, free_, b, x);
+  r.converged = direct_ok_ && direct_.solve(A, free_, b, x);
   return r;
 }
 
@@ -343,9 +208,9 @@ double ClothSystem::external_work(const VecX& u, const VecX& x0, const VecX& x1,
   for (int i = 0; i < p_; ++i)
     if (control && free_[i]) w += seg(u, i).dot(seg(x1, i) - seg(x0, i));
   for (int k : pinned_springs_) {
-    const BucklingSpring& s = springs_[k];
+    const BucklingSpring& s = assembly_.springs().list[k];
     // A pin does work -f . dx against the elastic force f on its particle (trapezoidal rule).
-    const Vec3 fa = 0.5 * (spring_force(s, x0) + spring_force(s, x1));
+    const Vec3 fa = 0.5 * (assembly_.conservative_spring_force(x0, k) + assembly_.conservative_spring_force(x1, k));
     if (!free_[s.a]) w -= fa.dot(seg(x1, s.a) - seg(x0, s.a));
     if (!free_[s.b]) w += fa.dot(seg(x1, s.b) - seg(x0, s.b));
   }
@@ -470,33 +335,15 @@ void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v,
   c_ = v + dv;  // v1 (without an explicit control's h u / m: what K multiplies in the step's equation)
   xhat.resize(3 * p_);
   vhat.resize(3 * p_);
-  // Per spring, with dw = w_b - w_a and G = d f_a / d x_b (elastic + damping, exact): (Kx^T w)_a = G^T dw,
-  // (Kx^T w)_b = -(that). The exact adjoint adds the derivative of the spring's part of
-  // w^T (h K v1 + D dv) = -dw^T (h B dv1 + B_d ddv) in x_a (its negative in x_b); xhat gets h times the sum.
-  const int ns = int(springs_.size());
-  tbb::parallel_for(tbb::blocked_range<int>(0, ns, kSpringGrain), [&](const tbb::blocked_range<int>& r) {
-    for (int k = r.begin(); k < r.end(); ++k) {
-      const BucklingSpring& s = springs_[k];
-      const Vec3 dw = seg(w, s.b) - seg(w, s.a);
-      const bool derivative = exact && dw.squaredNorm() > 0;
-      Vec3 t, dK;
-      // spring_state_ is this substep's: assemble() above ran at the same positions.
-      spring_adjoint_products(s, spring_state_[k], derivative, dw, seg(c_, s.b) - seg(c_, s.a), t, dK);
-      if (derivative) t += hs * dK;
-      if (k < damped_)
-        t += damping_adjoint_products(s, spec_.damping, spring_state_[k], v, dw, derivative,
-                                      seg(dv, s.b) - seg(dv, s.a));
-      spring_f_[k] = t;
-    }
-  });
-  tbb::parallel_for(tbb::blocked_range<int>(0, p_, kParticleGrain), [&](const tbb::blocked_range<int>& r) {
+  // Per spring (cloth_term.h): its share of (Kx^T w)_a, the derivative terms of the exact adjoint with it;
+  // (Kx^T w)_b is its negative. xhat gets hs times each particle's sum.
+  const ClothAdjoint a{n, hs, exact, x, v, mass_, w, c_, dv};
+  assembly_.adjoint_springs(a);
+  const BlockSparse3& A = assembly_.matrix();
+  tbb::parallel_for(tbb::blocked_range<int>(0, p_, kClothParticleGrain), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i) {
-      Vec3 kw = Vec3::Zero();
-      for (int e = incident_start_[i]; e < incident_start_[i + 1]; ++e)
-        kw += incident_[e].sign * spring_f_[incident_[e].spring];
-      ContactForce c;
-      for (const auto& col : colliders_)
-        if (col->contact(n, seg(x, i), seg(v, i), /*definite=*/false, c)) kw += c.dfdx.transpose() * seg(w, i);
+      const AdjointRow row = assembly_.adjoint_row(a, i);
+      const Vec3& kw = row.x;
       // v1 = v + dv / theta: below 1, v1 keeps (1 - 1 / theta) of v beside what the solve gives.
       if (free_[i]) {
         seg(xhat, i) = seg(xhat1, i) + hs * kw;
@@ -505,17 +352,15 @@ void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v,
       } else {
         // x_pin enters the free rows through b (hs K) and through the prescribed dv = (track - x_pin) / h
         // - v (A / h), and (exact) its own v1 = v + dv / theta.
-        seg(xhat, i) = hs * kw + A_.row_times(i, w) / h;
+        seg(xhat, i) = hs * kw + A.row_times(i, w) / h;
         if (exact) seg(xhat, i) -= seg(vhat1, i) / hs;
         seg(vhat, i).setZero();
         if (exact && theta != 1) seg(vhat, i) = (1 - 1 / theta) * seg(vhat1, i);
       }
+      if constexpr (ClothAssembly::kVelocityAdjoint) seg(vhat, i) += hs * row.v;
     }
   }, tbb::static_partitioner());
-  for (const auto& col : colliders_) {
-    col->add_cross_transpose(n, w, hs, xhat);
-    if (exact) col->add_definite_stiffness_derivative(n, x, w, c_, hs * hs, xhat);
-  }
+  assembly_.adjoint_coupled(a, xhat, vhat);
   if (!spec_.explicit_controls()) {
     uhat += hs * w;
     return;
@@ -525,18 +370,8 @@ void ClothSystem::substep_adjoint(int n, double h, const VecX& x, const VecX& v,
     if (free_[i]) seg(uhat, i) += (h / mass_[i]) * Vec3(seg(vhat1, i) + h * seg(xhat1, i));
 }
 
-BlockSparse3 ClothSystem::block_matrix(const std::vector<Mat3>& per_spring, const std::vector<Mat3>& diagonal) const {
-  BlockSparse3 m = A_;
-  for (int i = 0; i < p_; ++i)
-    for (int k = A_.row_start(i); k < A_.row_start(i + 1); ++k) {
-      const int sp = slot_spring_[k];
-      m.block(k) = sp < 0 ? diagonal[i] : per_spring[sp];
-    }
-  return m;
-}
-
-SpMat ClothSystem::stiffness_matrix() const { return block_matrix(spring_K_, diag_K_).to_sparse(); }
-SpMat ClothSystem::damping_matrix() const { return block_matrix(spring_D_, diag_D_).to_sparse(); }
+SpMat ClothSystem::stiffness_matrix() const { return assembly_.stiffness_blocks().to_sparse(); }
+SpMat ClothSystem::damping_matrix() const { return assembly_.damping_blocks().to_sparse(); }
 
 void ClothSystem::save_step_context(int n, VecX& context) const { forward_start_.save(n, context); }
 
@@ -545,7 +380,7 @@ void ClothSystem::restore_step_context(int n, const VecX& context) { forward_sta
 std::string ClothSystem::describe() const {
   std::ostringstream os, tolerance;
   tolerance << spec_.cg_tolerance;
-  os << "cloth: " << spec_.nx << "x" << spec_.ny << " particles, " << springs_.size() << " springs, "
+  os << "cloth: " << spec_.nx << "x" << spec_.ny << " particles, " << assembly_.springs().list.size() << " springs, "
      << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, "
      << (direct_solve_ ? std::string("sparse ") + FilteredDirect::backend() : std::string("PCG (") + preconditioner_name(preconditioner_kind(spec_.cg_preconditioner, p_)) + ", tolerance " + tolerance.str() + ")") << ", " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
   if (spec_.theta != 1) os << ", theta " << spec_.theta << " step";

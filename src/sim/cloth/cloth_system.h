@@ -1,5 +1,8 @@
 #pragma once
 // Choi-Ko cloth stepped by linearised backward Euler (design §4), with two adjoints.
+// The forces are the terms listed in cloth_terms.h (cloth_term.h says what a term gives); ClothAssembly sums
+// them into f, K, D and A, the energy and the adjoint's products. This file is the step, its energy check
+// and its adjoint.
 //
 // Forward:  A dv = b, A = M - h D - h^2 K, b = h (f + h K v + u), solved by PCG (IC(0) or multigrid) with pinned
 //           particles filtered out (Baraff-Witkin); v1 = v + dv, x1 = x + h v1. K is the springs'
@@ -35,6 +38,7 @@
 #include "scene/cloth_spec.h"
 #include "sim/cloth/block_sparse.h"
 #include "sim/cloth/buckling_spring.h"
+#include "sim/cloth/cloth_assembly.h"
 #include "sim/cloth/collider.h"
 #include "sim/cloth/direct_solve.h"
 #include "sim/cloth/filtered_pcg.h"
@@ -94,28 +98,25 @@ class ClothSystem final : public System {
   // alone), and force() is then stale.
   void assemble(int n, const VecX& x, const VecX& v, double hs = 0, bool forces = true);
   // Results of the last assemble: f (3p, N), K (N/m), D (N s/m), A (kg), as Eigen matrices (allocate).
-  const VecX& force() const { return force_; }
+  const VecX& force() const { return assembly_.force(); }
   SpMat stiffness_matrix() const;
   SpMat damping_matrix() const;
-  SpMat system_matrix() const { return A_.to_sparse(); }
+  SpMat system_matrix() const { return assembly_.matrix().to_sparse(); }
 
   const ClothSpec& spec() const { return spec_; }
-  const std::vector<BucklingSpring>& springs() const { return springs_; }
-  int damped_springs() const { return damped_; }
+  const std::vector<BucklingSpring>& springs() const { return assembly_.springs().list; }
+  int damped_springs() const { return assembly_.springs().damped; }
   int colliders() const { return int(colliders_.size()); }
   bool pinned(int i) const { return !free_[i]; }
   // Substeps of the last forward step (1 when it was not split).
   int last_substeps() const { return last_substeps_; }
-  // Energy (J) of a state at step n: free particles' kinetic and gravitational energy, every spring's,
-  // and the contact energy of the colliders that report it (Collider::energy).
-  struct Energy {
-    double kinetic = 0, gravity = 0, elastic = 0, contact = 0;
-    double total() const { return kinetic + gravity + elastic + contact; }
-  };
+  // Energy (J) of a state at step n: free particles' kinetic energy and the terms' (cloth_terms.h):
+  // free particles' gravitational energy, every spring's, and the contact energy of the colliders that
+  // report it (Collider::energy).
+  using Energy = ClothEnergy;
   Energy energy(int n, const VecX& x, const VecX& v) const;
   // The same without the colliders' part (which depends on n).
   Energy state_energy(const VecX& x, const VecX& v) const;
-  Vec3 stiffness_times_velocity(int i, const VecX& v) const;
   // PCG iterations of the last forward step (all its solves, a split step's rejected ones too) / of the last
   // backward solve (benchmarks, logs).
   int last_cg_iterations() const { return last_cg_; }
@@ -134,46 +135,27 @@ class ClothSystem final : public System {
                        const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat);
   // Solves the assembled A on the free set (x: prescribed values on pins, warm start on free ones).
   PcgResult solve(const VecX& b, VecX& x, bool warm);
-  Energy with_contact_energy(int n, const VecX& x, Energy e) const;  // e plus the colliders' part at step n
+  Energy with_contact_energy(int n, const VecX& x, const VecX& v, Energy e) const;  // e plus the colliders' part
   Energy energy_at_start(int n, const VecX& x, const VecX& v);
   void remember_energy(const VecX& x, const VecX& v, const Energy& e);
-  // K or D as a block matrix on A's pattern (diagnostics; allocates). spring_D_ stays zero for the
-  // undamped (bending) springs.
-  BlockSparse3 block_matrix(const std::vector<Mat3>& per_spring, const std::vector<Mat3>& diagonal) const;
   // Work (J) of the control u on the free particles and of the pins on their springs from x0 to x1.
   // `control`: whether u's work counts (an explicit control's kick is outside the checked solve).
   double external_work(const VecX& u, const VecX& x0, const VecX& x1, bool control) const;
 
-  struct Incident {
-    int spring;  // index into springs_
-    int sign;    // +1 when this particle is the spring's `a` end, -1 when it is `b`
-    int slot;    // block (this particle, other end) in the row
-  };
-
   ClothSpec spec_;
   int p_;
   double h_;
-  VecX mass_, x0_;
-  std::vector<BucklingSpring> springs_;
-  int damped_ = 0;  // springs_[0 .. damped_) carry damping (structural and shear)
-  std::vector<int> incident_start_;
-  std::vector<Incident> incident_;
-  std::vector<std::unique_ptr<Collider>> colliders_;
+  VecX x0_;
+  std::vector<std::unique_ptr<Collider>> colliders_;  // before assembly_, whose contact term reads them
+  ClothAssembly assembly_;                            // the force terms, f, K, D and A
+  VecX mass_;
   std::unique_ptr<PinTrack> pins_;
   std::vector<char> free_;
   std::vector<int> pinned_list_;
   std::vector<int> pinned_springs_;  // springs with a pinned end (the pins' work)
 
   // Per-step work space, sized once.
-  std::vector<Vec3> spring_f_;
-  std::vector<Mat3> spring_K_, spring_D_;
-  std::vector<SpringState> spring_state_;     // per spring: its length, direction and tension at the last assemble
-  mutable std::vector<double> energy_parts_;  // energy(): one partial sum per fixed chunk of springs
-  std::vector<Mat3> contact_K_;  // per particle: the colliders' part of K's diagonal block
-  BlockSparse3 A_;
-  std::vector<int> slot_spring_;        // per block of A: the spring joining its row and column, -1 on the diagonal
-  std::vector<Mat3> diag_K_, diag_D_;   // per particle: K's and D's diagonal blocks
-  VecX force_, rhs_, dv_, aw_;
+  VecX rhs_, dv_;
   WarmStart forward_start_{+1};  // the guess of each step's velocity change
   FilteredPcg pcg_;
   FilteredDirect direct_;  // cloth.solver = "direct"

@@ -1,0 +1,117 @@
+#include "opt/windows.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "sim/make_system.h"
+
+namespace kf {
+
+namespace {
+
+// The latest frame any keyframe reads (the scene's last frame when there are none).
+int last_keyframe(const Scene& scene) {
+  int last = 0;
+  for (const auto& o : scene.objectives) last = std::max(last, o.frame);
+  return scene.objectives.empty() ? scene.time.frames : std::min(last, scene.time.frames);
+}
+
+// Windows grown backwards from the last keyframe, sharing the budget equally.
+std::vector<StageSpec> window_stages(const Scene& scene) {
+  const OptimizerSpec& o = scene.optimizer;
+  const ControlSpec& c = scene.controls;
+  const int last = last_keyframe(scene);
+  std::vector<int> starts;  // latest first: K - w, K - 2w, K - 4w, ... above from_frame, then from_frame
+  for (long w = o.window_frames; last - w > c.from_frame; w *= 2) starts.push_back(int(last - w));
+  starts.push_back(c.from_frame);
+  const int n = int(starts.size());
+  const int part = std::max(1, o.max_evaluations / n);
+  std::vector<StageSpec> stages;
+  for (int k = 0; k < n; ++k) {
+    StageSpec s{scene.time.substeps, k + 1 < n ? part : std::max(1, o.max_evaluations - part * (n - 1)), std::nullopt};
+    if (k + 1 < n) {
+      ControlSpec window = c;
+      window.from_frame = starts[k];
+      s.controls = window;
+    }
+    stages.push_back(s);
+  }
+  return stages;
+}
+
+std::string describe(const std::vector<StageSpec>& stages, int scene_from) {
+  std::ostringstream os;
+  for (size_t k = 0; k < stages.size(); ++k)
+    os << (k ? ", " : "") << (stages[k].controls ? stages[k].controls->from_frame : scene_from);
+  return os.str();
+}
+
+}  // namespace
+
+double gradient_growth(Problem& problem, const VecX& z, int reference) {
+  const Controls& c = problem.controls();
+  const std::string kind = c.kind();
+  VecX g(problem.size());
+  problem.evaluate(z, &g);
+  if (problem.last_diverged() || (kind != "per_step" && kind != "per_frame")) return 0;
+  const int substeps = problem.time().substeps, frames = problem.time().frames, first = c.first_frame();
+  const long stride = kind == "per_frame" ? g.size() / std::max(1, frames - first)
+                                          : g.size() / std::max(1, (frames - first) * substeps);
+  std::vector<double> sq(frames, 0.0);  // squared gradient norm of each frame's forces
+  for (long b = 0; b * stride < g.size(); ++b) {
+    const int frame = first + int(kind == "per_frame" ? b : b / substeps);
+    sq[std::min(frame, frames - 1)] += g.segment(b * stride, stride).squaredNorm();
+  }
+  const double largest = std::sqrt(*std::max_element(sq.begin(), sq.end()));
+  const double ref = std::sqrt(sq[std::clamp(reference, 0, frames - 1)]);
+  if (largest == 0) return 1;
+  return ref > 0 ? largest / ref : std::numeric_limits<double>::infinity();
+}
+
+StagePlan plan_stages(const Scene& scene) {
+  const OptimizerSpec& o = scene.optimizer;
+  StagePlan plan;
+  const StageSpec whole{scene.time.substeps, o.max_evaluations, std::nullopt};
+  if (!o.schedule.empty()) {
+    plan.stages = o.schedule;
+    plan.why = "stages: the scene's schedule";
+    return plan;
+  }
+  plan.stages = {whole};
+  if (o.strategy == "single" || !scene.cloth || o.max_evaluations < 2) return plan;
+  const ControlSpec& c = scene.controls;
+  if (c.kind == ControlKind::kInitialVelocity) {
+    ControlSpec rigid = c;
+    rigid.kind = ControlKind::kInitialRigidVelocity;
+    const int rigid_budget = std::clamp(o.max_evaluations / 3, 1, 40);
+    plan.stages = {{scene.time.substeps, rigid_budget, rigid},
+                   {scene.time.substeps, o.max_evaluations - rigid_budget, std::nullopt}};
+    plan.why = "stages: a rigid throw (6 variables), then one initial velocity per particle from it";
+    plan.scaled_first_step = true;
+    return plan;
+  }
+  if (c.kind != ControlKind::kPerStep && c.kind != ControlKind::kPerFrame) return plan;
+  const int last = last_keyframe(scene);
+  if (last - o.window_frames <= c.from_frame) return plan;  // the whole horizon is one window already
+  auto sys = make_system(scene);
+  Problem problem(scene, scene.time, *sys);
+  plan.growth = gradient_growth(problem, problem.initial_guess(), last - 1);
+  std::ostringstream os;
+  os.precision(2);
+  os << "force gradient at the start grows " << plan.growth << "x from frame " << last - 1 << " back to frame "
+     << c.from_frame;
+  if (plan.growth > o.window_growth) {
+    plan.stages = window_stages(scene);
+    plan.scaled_first_step = true;
+    os << " (above optimizer.window_growth " << o.window_growth << "): windows from frames "
+       << describe(plan.stages, c.from_frame) << " to frame " << last;
+  } else {
+    os << " (not above optimizer.window_growth " << o.window_growth << "): one stage";
+  }
+  plan.why = os.str();
+  return plan;
+}
+
+}  // namespace kf

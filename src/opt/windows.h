@@ -1,0 +1,38 @@
+#pragma once
+// The stages a run optimises in. An exact gradient of cloth in contact, or released flat, grows by orders
+// of magnitude per frame: across a long horizon it describes nothing an optimiser can use. So, unless the
+// scene gives its own schedule or asks for optimizer.strategy "single", cloth is optimised in stages that
+// keep each gradient short:
+//  - forces (per_step / per_frame), when the gradient at the start grows across the horizon by more than
+//    optimizer.window_growth (the largest frame's force gradient over that of the last frame before the
+//    last keyframe), act first over the last `window_frames` frames before the last keyframe, then over
+//    windows twice, four times ... as long, down to controls.from_frame; each stage starts from the forces
+//    the last one found (new frames without force), so a longer window can only improve on it. A tame
+//    gradient (a sheet in free flight) keeps one stage.
+//  - per-particle initial velocities start from the best rigid throw (six numbers; ring-toss.json's stages).
+// Flocks, whose gradients stay tame, run in one stage.
+#include <string>
+#include <vector>
+
+#include "opt/problem.h"
+#include "scene/scene.h"
+
+namespace kf {
+
+struct StagePlan {
+  std::vector<StageSpec> stages;  // at least one; the last optimises the scene's own controls
+  double growth = 0;              // the force gradient's growth at the start (0: not measured)
+  // The strategy staged the run (windows, or a rigid throw first): an automatic optimizer.first_step is
+  // then the problem's control_scale(); elsewhere it is off, and a run is as it was without strategies.
+  bool scaled_first_step = false;
+  std::string why;                // one line: the plan and what chose it
+};
+
+// The stages of `scene`. Measuring the growth costs one simulation and its adjoint pass.
+StagePlan plan_stages(const Scene& scene);
+
+// Per-frame force controls' gradient at z: the largest frame's gradient norm over the norm of frame
+// `reference`'s (infinite when that is zero and another is not; 1 when all are zero).
+double gradient_growth(Problem& problem, const VecX& z, int reference);
+
+}  // namespace kf

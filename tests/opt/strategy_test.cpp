@@ -1,0 +1,158 @@
+// The optimisation strategy's pieces: the first trial step in the controls' units, and the stages
+// (windows grown backwards from the last keyframe, a rigid throw before per-particle velocities).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "opt/optimizer.h"
+#include "opt/problem.h"
+#include "opt/windows.h"
+#include "core/error.h"
+#include "scene/scene.h"
+#include "toy_system.h"
+
+namespace kf {
+namespace {
+
+Scene strategy_scene(const std::string& body, const std::string& controls, const std::string& optimizer = "{}") {
+  return parse_scene(R"({"time": {"fps": 30, "substeps": 2, "frames": 30}, )" + body + R"(,
+    "objectives": [{"type": "center_of_mass", "frame": 28, "target": [0.3, 0.1, 0.2], "weight": 1e8},
+                   {"type": "center_of_mass", "frame": 12, "target": [0.1, 0.1, 0.1]}],
+    "controls": )" + controls + R"(, "optimizer": )" + optimizer + "}",
+                     "strategy.json");
+}
+
+const char* kCloth = R"("cloth": {"nx": 2, "ny": 2})";
+
+// L-BFGS's first trial step on a steep start: the second evaluation of the run, compared with φ evaluated
+// here at z0 - c g for the step c the first_step asks for.
+struct FirstTrial {
+  double grad_norm = 0, phi0 = 0, trial_phi = 0, expected_phi = 0;
+};
+
+FirstTrial first_trial(double first_step) {
+  Scene scene = strategy_scene(kCloth, R"({"kind": "per_frame", "alpha": 1e-6})");
+  test::ToySystem sys(4, scene.time.h());
+  Problem problem(scene, scene.time, sys);
+  FirstTrial t;
+  const VecX z0 = problem.initial_guess();
+  VecX g(problem.size());
+  t.phi0 = problem.evaluate(z0, &g);
+  t.grad_norm = g.norm();
+  // The whole gradient without a first_step; else a step of first_step RMS per variable along it.
+  const double c = first_step > 0 ? first_step * std::sqrt(double(z0.size())) / t.grad_norm : 1.0;
+  t.expected_phi = problem.evaluate(z0 - c * g, nullptr);
+  OptimizerSpec spec;
+  spec.max_evaluations = 2;  // NLopt checks it between iterations, so the first line search may go on
+  spec.first_step = first_step;
+  const OptimizeResult r = minimize(problem, spec, z0);
+  EXPECT_GE(r.history.size(), 2u);
+  if (r.history.size() >= 2) t.trial_phi = r.history[1].phi;
+  return t;
+}
+
+TEST(Optimizer, FirstTrialStepMovesControlsByFirstStepRms) {
+  const FirstTrial t = first_trial(0.05);
+  ASSERT_GT(t.grad_norm, 1e4);  // steep: NLopt's own first step would be the whole gradient
+  EXPECT_LT(t.trial_phi, t.phi0);
+  EXPECT_NEAR(t.trial_phi, t.expected_phi, 1e-9 * t.expected_phi);
+}
+
+TEST(Optimizer, UnscaledFirstTrialStepIsTheWholeGradient) {
+  const FirstTrial t = first_trial(0);
+  EXPECT_GT(t.trial_phi, 100 * t.phi0);  // it overshoots a steep start by orders of magnitude
+  EXPECT_NEAR(t.trial_phi, t.expected_phi, 1e-9 * t.expected_phi);
+}
+
+TEST(Optimizer, AutomaticFirstStepIsTheMeanParticlesWeight) {
+  Scene scene = strategy_scene(kCloth, R"({"kind": "per_frame"})");
+  test::ToySystem sys(4, scene.time.h());
+  EXPECT_DOUBLE_EQ(Problem(scene, scene.time, sys).control_scale(), 9.81 * 1.5);
+  Scene thrown = strategy_scene(kCloth, R"({"kind": "initial_velocity"})");
+  EXPECT_DOUBLE_EQ(Problem(thrown, thrown.time, sys).control_scale(), 1.0);
+}
+
+std::vector<int> window_starts(const std::vector<StageSpec>& stages, int scene_from) {
+  std::vector<int> starts;
+  for (const auto& s : stages) starts.push_back(s.controls ? s.controls->from_frame : scene_from);
+  return starts;
+}
+
+TEST(Strategy, ClothForcesGrowWindowsBackwardsFromTheLastKeyframe) {
+  // A force early in free flight moves the keyframe more than a late one: growth above 1, so a threshold
+  // of 1 asks for windows.
+  const Scene scene = strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"max_evaluations": 300, "window_growth": 1})");
+  const StagePlan plan = plan_stages(scene);
+  EXPECT_GT(plan.growth, 1);
+  EXPECT_EQ(window_starts(plan.stages, 0), (std::vector<int>{23, 18, 8, 0}));
+  int budget = 0;
+  for (const auto& s : plan.stages) {
+    budget += s.max_evaluations;
+    EXPECT_EQ(s.substeps, 2);
+  }
+  EXPECT_EQ(budget, 300);
+  EXPECT_FALSE(plan.stages.back().controls);  // the last stage optimises the scene's own controls
+  EXPECT_TRUE(plan.scaled_first_step);
+  EXPECT_NE(plan.why.find("windows from frames 23, 18, 8, 0 to frame 28"), std::string::npos) << plan.why;
+  const Scene late = strategy_scene(kCloth, R"({"kind": "per_step", "from_frame": 20})",
+                                    R"({"window_frames": 3, "window_growth": 1})");
+  EXPECT_EQ(window_starts(plan_stages(late).stages, 20), (std::vector<int>{25, 22, 20}));
+  // The same scene below its threshold: one stage.
+  const Scene tame = strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"window_growth": 1e12})");
+  const StagePlan one = plan_stages(tame);
+  EXPECT_EQ(one.stages.size(), 1u);
+  EXPECT_EQ(one.growth, plan.growth);
+  EXPECT_FALSE(one.scaled_first_step);  // a run the strategy leaves alone runs as it did without it
+}
+
+// The growth is read from the gradient's frames: a keyframe's own frame's forces against earlier ones.
+TEST(Strategy, GradientGrowthComparesFramesOfTheForceGradient) {
+  const Scene scene = strategy_scene(kCloth, R"({"kind": "per_step", "from_frame": 4})");
+  test::ToySystem sys(4, scene.time.h());
+  Problem problem(scene, scene.time, sys);
+  const VecX z = problem.initial_guess();
+  VecX g(problem.size());
+  problem.evaluate(z, &g);
+  const long stride = 12, per_frame = 2 * stride;  // 4 particles x 3, two steps a frame
+  double largest = 0;
+  for (int f = 4; f < 30; ++f) largest = std::max(largest, g.segment((f - 4) * per_frame, per_frame).norm());
+  const double ref = g.segment((27 - 4) * per_frame, per_frame).norm();
+  EXPECT_NEAR(gradient_growth(problem, z, 27), largest / ref, 1e-12 * largest / ref);
+}
+
+TEST(Strategy, InitialVelocitiesStartFromARigidThrow) {
+  const Scene scene = strategy_scene(kCloth, R"({"kind": "initial_velocity", "alpha": 0.5})", R"({"max_evaluations": 90})");
+  const StagePlan plan = plan_stages(scene);
+  EXPECT_TRUE(plan.scaled_first_step);
+  const auto& stages = plan.stages;
+  ASSERT_EQ(stages.size(), 2u);
+  ASSERT_TRUE(stages[0].controls);
+  EXPECT_EQ(stages[0].controls->kind, ControlKind::kInitialRigidVelocity);
+  EXPECT_EQ(stages[0].controls->alpha, 0.5);
+  EXPECT_EQ(stages[0].max_evaluations + stages[1].max_evaluations, 90);
+  EXPECT_FALSE(stages[1].controls);
+}
+
+TEST(Strategy, SingleFlocksAndSchedulesRunAsWritten) {
+  EXPECT_EQ(plan_stages(strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"strategy": "single", "window_growth": 1})"))
+                .stages.size(),
+            1u);
+  const Scene flock = strategy_scene(R"("flock": {"agents": 4, "spawn": {"radius": 3}})", R"({"kind": "per_frame"})");
+  EXPECT_EQ(plan_stages(flock).stages.size(), 1u);
+  const Scene scheduled = strategy_scene(kCloth, R"({"kind": "per_frame"})",
+                                         R"({"schedule": [{"substeps": 1, "max_evaluations": 7}, {"substeps": 2}]})");
+  const auto stages = plan_stages(scheduled).stages;
+  ASSERT_EQ(stages.size(), 2u);
+  EXPECT_EQ(stages[0].max_evaluations, 7);
+  EXPECT_FALSE(stages[0].controls);
+}
+
+TEST(Strategy, BadKeysSayWhichAndWhy) {
+  EXPECT_THROW(strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"strategy": "multiple"})"), InputError);
+  EXPECT_THROW(strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"window_frames": 0})"), InputError);
+  EXPECT_THROW(strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"first_step": -1})"), InputError);
+  EXPECT_THROW(strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"window_growth": 0.5})"), InputError);
+}
+
+}  // namespace
+}  // namespace kf
