@@ -25,9 +25,6 @@ void add_optimize_options(CLI::App* sub, OptimizeOptions& o) {
                   "override the scene's optimizer.adjoint for cloth: exact (the transpose of the step's own "
                   "Jacobian) or swap (the paper's integrator-swapping approximation)")
       ->check(CLI::IsMember({"exact", "swap"}));
-  sub->add_option("--max-memory", o.max_memory,
-                  "refuse the run up front when its estimated memory exceeds this (e.g. 4G; default: the "
-                  "machine's memory)");
   sub->add_flag("--quiet", o.quiet, "no line per evaluation, only a progress display");
 }
 

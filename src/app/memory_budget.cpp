@@ -28,13 +28,13 @@ std::string format_bytes(std::uint64_t bytes) {
   return s;
 }
 
-MemoryEstimate simulate_memory(const Scene& scene) {
+RunMemory simulate_memory(const Scene& scene) {
   // simulate_frames keeps the frames' states, then frames_of copies them into the trajectory.
   const std::uint64_t frames = states_bytes(scene, scene.time.frames + 1.0);
   return {2 * frames, "frame states " + format_bytes(frames) + " + trajectory " + format_bytes(frames)};
 }
 
-MemoryEstimate optimize_memory(const Scene& scene, int substeps, int checkpoint_every) {
+RunMemory optimize_memory(const Scene& scene, int substeps, int checkpoint_every) {
   const double N = double(scene.time.frames) * substeps;
   // Stored mode keeps every state; checkpointed mode every k-th, a k-state segment buffer and the states
   // the keyframes read.
@@ -79,7 +79,7 @@ std::uint64_t parse_memory_size(const std::string& text) {
   return std::uint64_t(v);
 }
 
-void check_memory(const Scene& scene, const MemoryEstimate& need, std::uint64_t limit) {
+void check_memory(const Scene& scene, const RunMemory& need, std::uint64_t limit) {
   const bool machine = limit == 0;
   if (machine) limit = machine_memory();
   if (limit == 0 || need.bytes <= limit) return;

@@ -321,11 +321,16 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (opt.max_seconds >= 0) scene.optimizer.max_seconds = opt.max_seconds;
   const fs::path dir = resuming ? fs::path(opt.resume) : run_dir_for(scene, opt.out);
 
-  // Memory is checked at the scene's own time step before the stages are planned: planning a sensitive
-  // cloth simulates it once, which a run too large for the machine must not attempt.
-  const std::uint64_t memory_limit = opt.max_memory.empty() ? 0 : parse_memory_size(opt.max_memory);
-  const int checkpoint_every = opt.checkpoint_every >= 0 ? opt.checkpoint_every : scene.optimizer.checkpoint_every;
-  check_memory(scene, optimize_memory(scene, scene.time.substeps, checkpoint_every), memory_limit);
+  // A run that cannot fit in the machine's memory even at the checkpoint spacing that needs least (the
+  // memory budget below picks its spacing itself unless --checkpoint-every sets one) is refused before the
+  // stages are planned: planning a sensitive cloth simulates it once.
+  const auto least_memory = [&](int substeps) {
+    const int every = opt.checkpoint_every > 0
+                          ? opt.checkpoint_every
+                          : std::max(1, int(std::sqrt(double(scene.time.frames) * substeps)));
+    return optimize_memory(scene, substeps, every);
+  };
+  check_memory(scene, least_memory(scene.time.substeps), 0);
   // The stages of coarse-to-fine continuation; a resumed run continues in the last stage.
   const StagePlan plan = plan_stages(scene);
   std::vector<StageSpec> stages = plan.stages;
@@ -343,12 +348,12 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     stages.erase(stages.begin(), stages.end() - 1);
   }
   {
-    MemoryEstimate need;
+    RunMemory need;
     for (const auto& st : stages) {
-      const MemoryEstimate e = optimize_memory(scene, st.substeps, checkpoint_every);
+      const RunMemory e = least_memory(st.substeps);
       if (e.bytes > need.bytes) need = e;
     }
-    check_memory(scene, need, memory_limit);
+    check_memory(scene, need, 0);
   }
   // Build the first system before writing anything, so bad scenes leave no trace.
   TimeSpec& time = job.time;

@@ -17,7 +17,6 @@ struct OptimizeOptions {
   int checkpoint_every = -1;  // override the scene's optimizer.checkpoint_every when >= 0
   double max_memory = -1;     // override the scene's optimizer.max_memory (GB) when >= 0
   std::string adjoint;        // override the scene's optimizer.adjoint when not empty ("exact" | "swap")
-  std::string max_memory;     // refuse a run estimated to need more ("4G"); "" = the machine's memory
   double max_seconds = -1;    // override the scene's optimizer.max_seconds (per stage) when >= 0
 };
 

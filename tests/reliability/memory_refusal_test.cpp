@@ -34,7 +34,6 @@ TEST_F(MemoryRefusal, MaxMemoryIsALimitTheEstimateIsHeldTo) {
   expect_refused("simulate f.json --max-memory 1K",
                  "f.json: needs at least 7.9 KiB of memory (frame states 3.9 KiB + trajectory 3.9 KiB), more than "
                  "--max-memory 1.0 KiB; shorten the run, use fewer particles or set optimizer.checkpoint_every");
-  expect_refused("optimize f.json --quiet --max-memory 2K", "f.json: needs at least 7.9 KiB of memory (kept states");
   expect_refused("simulate f.json --max-memory lots",
                  "--max-memory: expected a size such as 4G, 512M or 1.5GiB, got \"lots\"");
   EXPECT_EQ(run_keyframe("simulate f.json --max-memory 1M", dir_).code, 0);
