@@ -62,9 +62,7 @@ std::string sentence_case(std::string s) {
   return s;
 }
 
-}  // namespace
-
-std::filesystem::path make_figure(const FigureRequest& r) {
+void check_request(const FigureRequest& r) {
   if (r.run_dirs.empty()) throw InputError("figure: expected at least one run directory");
   make_backend(r.backend);  // unknown names fail before any work
   if (r.width < 16 || r.height < 16 || r.width > 4096 || r.height > 4096)
@@ -73,6 +71,10 @@ std::filesystem::path make_figure(const FigureRequest& r) {
   for (char c : r.name)
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.'))
       throw InputError("figure: --name \"" + r.name + "\" may use only letters, digits, '-', '_' and '.'");
+}
+
+// Every run, read whole before any rendering; each requested frame checked against each run.
+std::vector<RunData> load_runs(const FigureRequest& r) {
   std::vector<RunData> runs;
   for (const auto& d : r.run_dirs) runs.push_back(load_run(d));
   for (size_t k = 0; k < runs.size(); ++k)
@@ -80,51 +82,74 @@ std::filesystem::path make_figure(const FigureRequest& r) {
       if ((f < 0 && f != kLastKeyframe && f != kLastFrame) || f >= runs[k].trajectory.frames())
         throw InputError("figure: frame " + std::to_string(f) + " out of range: " + r.run_dirs[k].string() +
                          " has frames 0.." + std::to_string(runs[k].trajectory.frames() - 1));
-  // Each run's tiles and captions, in request order.
-  std::vector<std::vector<Image>> tiles(runs.size());
-  std::vector<std::vector<std::string>> captions(runs.size());
-  for (size_t k = 0; k < runs.size(); ++k) {
-    const RunData& run = runs[k];
-    FrameRenderer renderer(run, r.backend, {r.width, r.height, r.spp});
-    const std::vector<int> frames = resolve_frames(run, r.frames);
-    std::vector<Image> images;
-    if (r.overlay && run.scene.flock) {
-      images.push_back(renderer.render_path(frames));
-    } else {
-      for (int f : frames) images.push_back(renderer.render(f));
-    }
-    if (r.overlay) {
-      tiles[k].push_back(overlay_frames(images));
-      captions[k].push_back("Frames " + std::to_string(frames.front()) + "\u2013" + std::to_string(frames.back()));
-    } else {
-      tiles[k] = std::move(images);
-      for (int f : frames) captions[k].push_back(frame_caption(run, f));
-    }
-  }
-  std::vector<FigureRow> rows;
-  if (!r.columns) {
-    // One run: the sheet's title already names it.
-    for (size_t k = 0; k < runs.size(); ++k)
-      rows.push_back({runs.size() > 1 ? sentence_case(runs[k].scene.name) : "", std::move(tiles[k]), captions[k]});
+  return runs;
+}
+
+struct RunTiles {
+  std::vector<Image> tiles;
+  std::vector<std::string> captions;
+};
+
+// One run's tiles and captions, in request order (one overlaid tile with --overlay).
+RunTiles render_tiles(const FigureRequest& r, const RunData& run) {
+  FrameRenderer renderer(run, r.backend, {r.width, r.height, r.spp});
+  const std::vector<int> frames = resolve_frames(run, r.frames);
+  std::vector<Image> images;
+  if (r.overlay && run.scene.flock) {
+    images.push_back(renderer.render_path(frames));
   } else {
-    // Transposed: row i holds every run's i-th tile; each caption names its run (and frame).
-    size_t depth = 0;
-    for (const auto& t : tiles) depth = std::max(depth, t.size());
-    for (size_t i = 0; i < depth; ++i) {
-      FigureRow row;
-      bool same = true;
-      for (size_t k = 0; k < runs.size(); ++k)
-        same = same && i < captions[k].size() && captions[k][i] == captions[0][i];
-      row.label = same && i < captions[0].size() ? captions[0][i] : "";
-      for (size_t k = 0; k < runs.size(); ++k) {
-        if (i >= tiles[k].size()) continue;
-        row.tiles.push_back(std::move(tiles[k][i]));
-        const std::string run_name = sentence_case(runs[k].scene.name);
-        row.captions.push_back(same ? run_name : run_name + ", " + lower_first(captions[k][i]));
-      }
-      rows.push_back(std::move(row));
-    }
+    for (int f : frames) images.push_back(renderer.render(f));
   }
+  RunTiles t;
+  if (r.overlay) {
+    t.tiles.push_back(overlay_frames(images));
+    t.captions.push_back("Frames " + std::to_string(frames.front()) + "\u2013" + std::to_string(frames.back()));
+  } else {
+    t.tiles = std::move(images);
+    for (int f : frames) t.captions.push_back(frame_caption(run, f));
+  }
+  return t;
+}
+
+// One row per run; with one run the sheet's title already names it.
+std::vector<FigureRow> rows_by_run(const std::vector<RunData>& runs, std::vector<RunTiles>& tiles) {
+  std::vector<FigureRow> rows;
+  for (size_t k = 0; k < runs.size(); ++k)
+    rows.push_back({runs.size() > 1 ? sentence_case(runs[k].scene.name) : "", std::move(tiles[k].tiles),
+                    tiles[k].captions});
+  return rows;
+}
+
+// Transposed: row i holds every run's i-th tile; each caption names its run (and frame).
+std::vector<FigureRow> rows_by_column(const std::vector<RunData>& runs, std::vector<RunTiles>& tiles) {
+  size_t depth = 0;
+  for (const auto& t : tiles) depth = std::max(depth, t.tiles.size());
+  std::vector<FigureRow> rows;
+  for (size_t i = 0; i < depth; ++i) {
+    FigureRow row;
+    bool same = true;
+    for (size_t k = 0; k < runs.size(); ++k)
+      same = same && i < tiles[k].captions.size() && tiles[k].captions[i] == tiles[0].captions[i];
+    row.label = same && i < tiles[0].captions.size() ? tiles[0].captions[i] : "";
+    for (size_t k = 0; k < runs.size(); ++k) {
+      if (i >= tiles[k].tiles.size()) continue;
+      row.tiles.push_back(std::move(tiles[k].tiles[i]));
+      const std::string run_name = sentence_case(runs[k].scene.name);
+      row.captions.push_back(same ? run_name : run_name + ", " + lower_first(tiles[k].captions[i]));
+    }
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+}  // namespace
+
+std::filesystem::path make_figure(const FigureRequest& r) {
+  check_request(r);
+  const std::vector<RunData> runs = load_runs(r);
+  std::vector<RunTiles> tiles;
+  for (const RunData& run : runs) tiles.push_back(render_tiles(r, run));
+  std::vector<FigureRow> rows = r.columns ? rows_by_column(runs, tiles) : rows_by_run(runs, tiles);
   const std::string name = r.name.empty() ? runs.front().scene.name : r.name;
   const FigureSheet sheet{r.title.empty() ? sentence_case(runs.front().scene.name) : r.title, std::move(rows),
                           r.caption};

@@ -33,6 +33,39 @@ void add_agent(Mesh& m, const Vec3& pos, const Vec3& heading, double len, const 
   add_flat_triangle(m, top, right, notch, color);
 }
 
+// The first shape keyframe at or after frame f (-1: none).
+int next_shape_keyframe(const Scene& scene, int f) {
+  int next = -1;
+  for (size_t k = 0; k < scene.objectives.size(); ++k) {
+    const auto& o = scene.objectives[k];
+    if (std::holds_alternative<ShapeKeyframe>(o.kind) && o.frame >= f &&
+        (next < 0 || o.frame < scene.objectives[next].frame))
+      next = int(k);
+  }
+  return next;
+}
+
+// A centre-of-mass path on the ground: a line through its points and a dot at each target.
+void add_path(Mesh& m, const std::vector<Vec3>& pts, double line, const Vec3& color) {
+  const Vec3 n = Vec3::UnitY();
+  add_ribbon(m, pts, false, line, n, color);
+  for (size_t k = 1; k < pts.size(); ++k) add_disc(m, pts[k], n, 2.0 * line, color);
+}
+
+// Every agent of frame f at height y, a highlighted agent ringed.
+void add_agents(const RenderSpec& rs, const Trajectory& traj, int f, double y, const std::vector<char>& highlighted,
+                FrameGeometry& g) {
+  const double len = rs.agent_size, line = 0.12 * len;
+  for (int i = 0; i < traj.particles; ++i) {
+    const Vec3 x = seg(traj.x[f], i);
+    const Vec3 pos(x.x(), y, x.z());
+    add_agent(g.objects, pos, heading_of(traj, f, i), len, highlighted[i] ? rs.highlight_color : rs.agent_color);
+    if (highlighted[i])
+      add_ribbon(g.marks, circle_points(pos, Vec3::UnitY(), 0.9 * len, 40), true, line, Vec3::UnitY(),
+                 rs.highlight_color);
+  }
+}
+
 }  // namespace
 
 void build_flock(const Scene& scene, const Trajectory& traj, int f, double scale, const GroundPlane& plane,
@@ -43,14 +76,7 @@ void build_flock(const Scene& scene, const Trajectory& traj, int f, double scale
   const Vec3 n = Vec3::UnitY();
   auto on_ground = [&](double x, double z) { return Vec3(x, plane.offset + lift, z); };
   std::vector<char> highlighted(p, 0);
-  // The next shape keyframe is drawn strongly, the others faded.
-  int next_shape = -1;
-  for (size_t k = 0; k < scene.objectives.size(); ++k) {
-    const auto& o = scene.objectives[k];
-    if (std::holds_alternative<ShapeKeyframe>(o.kind) && o.frame >= f &&
-        (next_shape < 0 || o.frame < scene.objectives[next_shape].frame))
-      next_shape = int(k);
-  }
+  const int next_shape = next_shape_keyframe(scene, f);  // drawn strongly, the others faded
   std::vector<std::pair<int, Vec3>> com;  // (frame, target) of the centre-of-mass keyframes
   for (size_t k = 0; k < scene.objectives.size(); ++k) {
     const auto& o = scene.objectives[k];
@@ -87,16 +113,9 @@ void build_flock(const Scene& scene, const Trajectory& traj, int f, double scale
     c0 /= std::max(p, 1);
     std::vector<Vec3> pts = {on_ground(c0.x(), c0.z())};
     for (const auto& [frame, target] : com) pts.push_back(on_ground(target.x(), target.z()));
-    add_ribbon(g.marks, pts, false, line, n, rs.path_color);
-    for (size_t k = 1; k < pts.size(); ++k) add_disc(g.marks, pts[k], n, 2.0 * line, rs.path_color);
+    add_path(g.marks, pts, line, rs.path_color);
   }
-  for (int i = 0; i < p; ++i) {
-    const Vec3 x = seg(traj.x[f], i);
-    const Vec3 pos(x.x(), plane.offset + lift, x.z());
-    add_agent(g.objects, pos, heading_of(traj, f, i), len, highlighted[i] ? rs.highlight_color : rs.agent_color);
-    if (highlighted[i])
-      add_ribbon(g.marks, circle_points(pos, n, 0.9 * len, 40), true, line, n, rs.highlight_color);
-  }
+  add_agents(rs, traj, f, plane.offset + lift, highlighted, g);
 }
 
 void add_flock_path(const Scene& scene, const Trajectory& traj, const std::vector<int>& snapshots,

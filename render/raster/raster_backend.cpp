@@ -115,13 +115,35 @@ class RasterBackend final : public Backend {
   Image render(const FrameGeometry& g, const Camera& camera, const RenderSpec& look,
                const RenderSettings& settings) override {
     setup(settings.width, settings.height, settings.spp > 0 ? settings.spp : 4);
-    if (g.ground_id != ground_id_) {
+    upload_meshes(g);
+    set_uniforms(g, camera, look);
+    draw_passes(look);
+    return read_back();
+  }
+
+  ~RasterBackend() override {
+    if (!context_) return;
+    context_->make_current();
+    release_targets();
+    for (auto& m : meshes_) {
+      glDeleteVertexArrays(1, &m.vao);
+      glDeleteBuffers(1, &m.vbo);
+      glDeleteBuffers(1, &m.ibo);
+    }
+    glDeleteProgram(program_);
+  }
+
+ private:
+  void upload_meshes(const FrameGeometry& g) {
+    if (g.ground_id != ground_id_) {  // the ground rarely changes between frames
       meshes_[0].upload(g.ground);
       ground_id_ = g.ground_id;
     }
     meshes_[1].upload(g.marks);
     meshes_[2].upload(g.objects);
+  }
 
+  void set_uniforms(const FrameGeometry& g, const Camera& camera, const RenderSpec& look) {
     const Vec3 center = camera.target;
     const double reach = (camera.eye - center).norm() + 40.0 * g.scale;
     const Eigen::Matrix4f vp = (camera.projection(std::max(1e-3 * reach, 0.02 * (camera.eye - center).norm()), reach) *
@@ -138,7 +160,10 @@ class RasterBackend final : public Backend {
     glUniform1f(loc("ambient"), light.ambient);
     glUniform1f(loc("norm_k"), light.norm_k);
     glUniform1f(loc("shadow_alpha"), light.shadow_alpha);
+  }
 
+  // Ground, then the marks on it, then the objects' shadows on the ground, then the objects.
+  void draw_passes(const RenderSpec& look) {
     glBindFramebuffer(GL_FRAMEBUFFER, msaa_fbo_);
     glViewport(0, 0, width_, height_);
     glClearColor(float(look.background.x()), float(look.background.y()), float(look.background.z()), 1.0f);
@@ -152,33 +177,37 @@ class RasterBackend final : public Backend {
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(-1.0f, -2.0f);
     meshes_[1].draw();
-    if (meshes_[0].count > 0) {
-      // Each ground pixel is darkened once however many objects shade it (stencil).
-      glUniform1i(loc("shadow_pass"), 1);
-      glPolygonOffset(-2.0f, -4.0f);
-      glDepthMask(GL_FALSE);
-      glEnable(GL_BLEND);
-      glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-      glEnable(GL_STENCIL_TEST);
-      glStencilFunc(GL_EQUAL, 0, 0xff);
-      glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
-      meshes_[2].draw();
-      glDisable(GL_STENCIL_TEST);
-      glDisable(GL_BLEND);
-      glDepthMask(GL_TRUE);
-      glUniform1i(loc("shadow_pass"), 0);
-    }
+    if (meshes_[0].count > 0) draw_shadows();
     glDisable(GL_POLYGON_OFFSET_FILL);
     meshes_[2].draw();
+  }
 
+  // Each ground pixel is darkened once however many objects shade it (stencil).
+  void draw_shadows() {
+    glUniform1i(loc("shadow_pass"), 1);
+    glPolygonOffset(-2.0f, -4.0f);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glEnable(GL_STENCIL_TEST);
+    glStencilFunc(GL_EQUAL, 0, 0xff);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
+    meshes_[2].draw();
+    glDisable(GL_STENCIL_TEST);
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
+    glUniform1i(loc("shadow_pass"), 0);
+  }
+
+  // Resolve the multisampled target, read RGB straight into the image, then flip it row by row (OpenGL's
+  // rows start at the bottom): a per-channel copy loop cost as much as drawing the frame.
+  Image read_back() {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, msaa_fbo_);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo_);
     glBlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo_);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     Image img(width_, height_, 3);
-    // Read RGB straight into the image, then flip it row by row (OpenGL's rows start at the bottom):
-    // a per-channel copy loop cost as much as drawing the frame.
     glReadPixels(0, 0, width_, height_, GL_RGB, GL_UNSIGNED_BYTE, img.pixels.data());
     if (GLenum e = glGetError(); e != GL_NO_ERROR)
       throw std::runtime_error("OpenGL error " + std::to_string(e) + " while rendering");
@@ -194,19 +223,6 @@ class RasterBackend final : public Backend {
     return img;
   }
 
-  ~RasterBackend() override {
-    if (!context_) return;
-    context_->make_current();
-    release_targets();
-    for (auto& m : meshes_) {
-      glDeleteVertexArrays(1, &m.vao);
-      glDeleteBuffers(1, &m.vbo);
-      glDeleteBuffers(1, &m.ibo);
-    }
-    glDeleteProgram(program_);
-  }
-
- private:
   GLint loc(const char* name) const { return glGetUniformLocation(program_, name); }
 
   void setup(int width, int height, int samples) {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "adjoint/memory_estimate.h"
+
 namespace kf {
 
 Trajectory frames_of(const Rollout& r, const TimeSpec& t, int particles) {
@@ -39,7 +41,15 @@ void ensure_tape(const System& sys, std::vector<std::unique_ptr<StepRecord>>& ta
 
 bool simulate(System& sys, const VecX& x0, const VecX& v0, int N, const StepControl& u, Rollout& r,
               const RolloutOptions& options) {
-  const int dof = int(x0.size()), every = options.checkpoint_every;
+  const int dof = int(x0.size());
+  int every = options.checkpoint_every;
+  if (every <= 0 && options.memory_budget > 0) {
+    int costed = 0;
+    if (options.keep_for)
+      for (int n = 0; n <= N; ++n) costed += options.keep_for->active(n);
+    bool fits = false;
+    every = checkpoint_spacing_for(estimate_rollout_memory(sys, N, costed), options.memory_budget, fits);
+  }
   r.x.resize(N + 1);
   r.v.resize(N + 1);
   r.every = every;

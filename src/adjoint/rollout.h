@@ -54,8 +54,11 @@ using StepControl = std::function<const VecX&(int n)>;
 using StepControlGradient = std::function<void(int n, const VecX& uhat)>;
 
 struct RolloutOptions {
-  int checkpoint_every = 0;             // 0: keep every state
+  int checkpoint_every = 0;             // 0: keep every state (unless the budget below asks otherwise)
   const StateCost* keep_for = nullptr;  // checkpointed: also keep the states where this cost is active
+  // Bytes the rollout's states and tape may hold (0: no limit). With checkpoint_every = 0, a rollout
+  // whose estimate (adjoint/memory_estimate.h) passes it is checkpointed at the spacing that needs least.
+  std::size_t memory_budget = 0;
 };
 
 // Runs N steps from (x0, v0) under the controls. Returns false (and sets diverged_at) when a step

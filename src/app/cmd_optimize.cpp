@@ -16,6 +16,11 @@ void add_optimize_options(CLI::App* sub, OptimizeOptions& o) {
                   "override the scene's optimizer.checkpoint_every: keep every k-th state for the adjoint pass "
                   "and recompute the rest (0 = keep all states)")
       ->check(CLI::Range(0, 10000000));
+  sub->add_option("--max-memory", o.max_memory,
+                  "override the scene's optimizer.max_memory: memory budget in GB (1e9 bytes; 0 = half the "
+                  "machine's); when keeping every step for the adjoint is estimated to pass it, the run "
+                  "checkpoints instead (same gradient, about one more forward pass)")
+      ->check(CLI::Range(0.0, 1e6));
   sub->add_option("--adjoint", o.adjoint,
                   "override the scene's optimizer.adjoint for cloth: exact (the transpose of the step's own "
                   "Jacobian) or swap (the paper's integrator-swapping approximation)")

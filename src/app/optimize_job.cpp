@@ -8,6 +8,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "adjoint/memory_estimate.h"
 #include "adjoint/rollout.h"
 #include "app/body_meshes.h"
 #include "report/plot.h"
@@ -194,9 +195,34 @@ struct JobResult {
   bool interrupted = false;
   int evaluations = 0;
   double seconds = 0;
+  double memory_budget_gb = 0;  // the run's budget
+  int auto_checkpoint_every = 0;  // spacing the budget asked for in the last stage (0: none)
   std::vector<StageResult> stages;
   Diagnosis diagnosis;
 };
+
+// The rollout budget of a problem within a run's budget (bytes): what the optimiser's vectors leave, and the
+// line that says whether checkpointing is on. At least 1 byte, so a run over budget checkpoints as tightly as
+// it can.
+std::size_t rollout_budget(const Problem& problem, System& sys, int lbfgs_memory, std::size_t budget, int& every,
+                           std::string& line) {
+  const std::size_t fixed = optimizer_bytes(std::size_t(problem.size()), lbfgs_memory);
+  const std::size_t left = budget > fixed ? budget - fixed : 1;
+  int costed = 0;
+  for (int n = 0; n <= problem.time().steps(); ++n) costed += problem.active(n);
+  MemoryEstimate e = estimate_rollout_memory(sys, problem.time().steps(), costed);
+  bool fits = false;
+  every = checkpoint_spacing_for(e, left, fits);
+  e.base = fixed;
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(2) << "memory: estimate " << e.bytes(0) / 1e9
+     << " GB keeping every step, budget " << budget / 1e9 << " GB";
+  if (every > 0)
+    os << ": checkpointing every " << every << " steps (estimate " << e.bytes(every) / 1e9 << " GB"
+       << (fits ? ")" : ", still over the budget)");
+  line = os.str();
+  return left;
+}
 
 // Simulates the best point (and, for a cape blend, the uncontrolled run its end state is measured
 // against), then writes controls.bin, trajectory.bin, meshes.bin, iterations.csv, convergence.png and
@@ -232,6 +258,8 @@ nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, size_t 
                            {"steps", job.time.steps()},
                            {"substeps", job.time.substeps},
                            {"checkpoint_every", problem.checkpoint_every()},
+                           {"memory_budget_gb", job.memory_budget_gb},
+                           {"checkpoint_every_for_budget", job.auto_checkpoint_every},
                            {"adjoint", scene.optimizer.adjoint},
                            {"stages", stages},
                            {"resumed", resuming},
@@ -321,6 +349,13 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     job.problem = std::make_unique<Problem>(stage_scene, time, *job.sys);
     Problem& problem = *job.problem;
     if (opt.checkpoint_every >= 0) problem.set_checkpoint_every(opt.checkpoint_every);
+    const double max_gb = opt.max_memory >= 0 ? opt.max_memory : scene.optimizer.max_memory;
+    const std::size_t budget = max_gb > 0 ? std::size_t(max_gb * 1e9) : default_memory_budget();
+    job.memory_budget_gb = budget / 1e9;
+    std::string memory_line;
+    problem.set_memory_budget(rollout_budget(problem, *job.sys, scene.optimizer.memory, budget,
+                                             job.auto_checkpoint_every, memory_line));
+    if (problem.checkpoint_every() > 0) job.auto_checkpoint_every = 0;
     if (z.size() == 0) z = problem.initial_guess();
     else if (v0_before.size()) z = problem.controls().from_initial_velocity(v0_before);
     else z = problem.controls().remap_from(z, z_time, z_from_frame);
@@ -335,6 +370,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
              std::to_string(problem.size()) + " control variables (" + problem.controls().kind() +
              (problem.controls().first_frame() > 0 ? " from frame " + std::to_string(problem.controls().first_frame()) : "") +
              ")");
+    if (problem.checkpoint_every() == 0) elog.say(memory_line);
     OptimizerSpec spec = scene.optimizer;
     spec.max_evaluations = stages[s].max_evaluations;
     if (spec.first_step < 0) spec.first_step = plan.scaled_first_step ? problem.control_scale() : 0;

@@ -15,6 +15,7 @@ struct OptimizeOptions {
   bool quiet = false;         // no per-evaluation lines on stdout
   std::string resume;         // run directory to continue from (its scene.json and controls.bin)
   int checkpoint_every = -1;  // override the scene's optimizer.checkpoint_every when >= 0
+  double max_memory = -1;     // override the scene's optimizer.max_memory (GB) when >= 0
   std::string adjoint;        // override the scene's optimizer.adjoint when not empty ("exact" | "swap")
   double max_seconds = -1;    // override the scene's optimizer.max_seconds (per stage) when >= 0
 };
@@ -30,7 +31,8 @@ struct OptimizeOutcome {
 // directory and returns with interrupted = true.
 OptimizeOutcome optimize_job(const std::filesystem::path& scene_file, const OptimizeOptions& options);
 
-// The options `optimize` and `run` share (--out, --max-evaluations, --checkpoint-every, --adjoint, --quiet).
+// The options `optimize` and `run` share (--out, --max-evaluations, --checkpoint-every, --max-memory, --adjoint,
+// --quiet).
 void add_optimize_options(CLI::App* sub, OptimizeOptions& o);
 // Exits with kExitInterrupted when the job was stopped by a signal (after it saved its run directory).
 void exit_if_interrupted(const OptimizeOutcome& r);

@@ -48,6 +48,7 @@ double Problem::evaluate(const VecX& z, VecX* grad) {
   };
   RolloutOptions options;
   options.checkpoint_every = grad ? checkpoint_every_ : 0;
+  options.memory_budget = grad ? memory_budget_ : 0;
   options.keep_for = this;
   bool ok = simulate(sys_, x0_, v0_, time_.steps(), u_at, rollout_, options);
   long double phi = 0;  // extended, like each term's sum: φ's round-off is a gradient check's floor

@@ -1,6 +1,7 @@
 #pragma once
 // The optimisation problem φ(z): simulate under the controls z, sum the keyframe terms and the control
 // effort, and get dφ/dz from one adjoint pass.
+#include <cstddef>
 #include <memory>
 #include <string>
 #include <vector>
@@ -37,6 +38,9 @@ class Problem : public StateCost {
   // is the same bit for bit either way. Evaluations without a gradient always keep every state.
   void set_checkpoint_every(int k) { checkpoint_every_ = k; }
   int checkpoint_every() const { return checkpoint_every_; }
+  // Bytes the rollout of an evaluation with a gradient may hold (0: no limit): with checkpoint_every 0,
+  // one whose estimate passes it is checkpointed (RolloutOptions::memory_budget). rollout().every tells.
+  void set_memory_budget(std::size_t bytes) { memory_budget_ = bytes; }
 
   // Values of each term (keyframe terms by name, then "effort") at the last evaluated point.
   const std::vector<std::pair<std::string, double>>& breakdown() const { return breakdown_; }
@@ -58,6 +62,7 @@ class Problem : public StateCost {
   VecX v0_;
   VecX u_;  // control force of the step being simulated
   int checkpoint_every_ = 0;
+  std::size_t memory_budget_ = 0;
   VecX dx0_, dv0_;
   Rollout rollout_;
   bool diverged_ = false;

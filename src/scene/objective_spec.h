@@ -100,6 +100,9 @@ struct OptimizerSpec {
   int memory = 10;         // L-BFGS vectors
   std::vector<StageSpec> schedule;  // empty: one stage at the scene's substeps
   int checkpoint_every = 0;  // adjoint pass keeps every k-th state and recomputes the rest; 0: keep all
+  // Memory budget of a run (GB = 1e9 bytes; 0: half the machine's memory). With checkpoint_every 0, the
+  // adjoint is checkpointed when keeping every step is estimated to pass it.
+  double max_memory = 0;
   // Fresh L-BFGS starts from the best point after a stalled line search, within each stage's budget
   // (an approximate gradient stalls the line search long before the objective stops falling).
   int restarts = 0;

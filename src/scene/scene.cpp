@@ -142,6 +142,7 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls) {
     o.schedule.push_back(st);
   }
   o.checkpoint_every = b.integer("checkpoint_every", o.checkpoint_every, 0, 10'000'000);
+  o.max_memory = b.number("max_memory", o.max_memory, 0.0, 1e6);
   o.restarts = b.integer("restarts", o.restarts, 0, 1000);
   o.adjoint = b.string("adjoint", o.adjoint, {"exact", "swap"});
   o.strategy = b.string("strategy", o.strategy, {"auto", "single"});

@@ -4,6 +4,7 @@
 // State: positions x and velocities v, 3p entries each (metres, m/s, world frame, Y up).
 // Controls: an external force u_n (3p, newtons) applied during step n (n = 0 .. steps-1).
 // The step length h is fixed when the system is built from a scene.
+#include <cstddef>
 #include <memory>
 #include <string>
 #include <utility>
@@ -35,6 +36,9 @@ class System {
 
   // A fresh tape entry for this system's steps.
   virtual std::unique_ptr<StepRecord> new_record() const { return std::make_unique<StepRecord>(); }
+  // Bytes one tape entry is expected to hold, for the memory estimate made before a run (it decides
+  // whether to checkpoint). Systems without their own estimate count one state's worth (6p doubles).
+  virtual std::size_t record_bytes_estimate() const { return 6 * sizeof(double) * std::size_t(particles()); }
 
   // Advances the state of step n by one step under control force u and writes what its adjoint needs to
   // `record`. Returns false when the result is not finite or an inner solve failed; the caller treats

@@ -62,8 +62,10 @@ TEST_F(GradcheckBenchCli, GradcheckPrintsOneJsonObjectWithTheChecksNumbers) {
 }
 
 TEST_F(GradcheckBenchCli, TinyFlockBenchWritesItsCsvPlotAndSummary) {
-  const auto r =
-      run_keyframe("bench --only flock --agents 20,40 --flock-frames 5 --flock-evaluations 3 --out b", dir_);
+  const std::string crowd = " --crowd-scene " KEYFRAME_SOURCE_DIR "/scenes/square.json --crowd-agents 40 "
+                            "--crowd-evaluations 2 --crowd-budget-agents 40 --crowd-budget 0.0001";
+  const auto r = run_keyframe(
+      "bench --only flock --agents 20,40 --flock-frames 5 --flock-evaluations 3 --out b" + crowd, dir_);
   ASSERT_EQ(r.code, kExitOk) << r.output;
   std::ifstream csv(dir_ / "b/flock_agents.csv");
   std::string header, line;
@@ -95,6 +97,32 @@ TEST_F(GradcheckBenchCli, TinyFlockBenchWritesItsCsvPlotAndSummary) {
   std::ifstream summary_file(dir_ / "b/summary.json");
   const auto summary = nlohmann::json::parse(summary_file);
   EXPECT_TRUE(std::isfinite(summary["flock"]["gradient_exponent"].get<double>())) << summary.dump();
+
+  // The crowd sweep: the square figure scaled to 40 agents, once as it is and once under a budget far
+  // below what keeping every step needs, which checkpoints.
+  std::ifstream crowd_csv(dir_ / "b/flock_crowd.csv");
+  std::getline(crowd_csv, header);
+  EXPECT_EQ(header.rfind("agents,control_variables,steps,max_memory_gb,checkpoint_every,evaluations,optimize_s,"
+                         "s_per_evaluation,peak_mb,",
+                         0),
+            0u)
+      << header;
+  std::vector<std::vector<std::string>> crowd_rows;
+  while (std::getline(crowd_csv, line)) {
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    crowd_rows.push_back(cells);
+  }
+  ASSERT_EQ(crowd_rows.size(), 2u);
+  for (const auto& row : crowd_rows) {
+    EXPECT_EQ(row[0], "40");
+    EXPECT_EQ(row[5], "2");           // evaluations
+    EXPECT_GT(std::stod(row[8]), 1);  // peak MB of the child process
+  }
+  EXPECT_EQ(crowd_rows[0][4], "0");
+  EXPECT_GT(std::stoi(crowd_rows[1][4]), 1) << "the budget must switch checkpointing on";
+  EXPECT_TRUE(summary["crowd"]["evaluation_exponent"].is_null()) << "one size has no slope";
 }
 
 // The solver sweep on two tiny sheets: one column triple per solver and thread count, every cell measured

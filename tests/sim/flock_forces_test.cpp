@@ -135,7 +135,7 @@ TEST(MatchingForce, PairValueAndJacobiansMatchFiniteDifferences) {
 TEST(WanderForce, SeededSmoothAndTabulatedEqualsFormula) {
   const WanderParams p{0.5, 10, 42};
   WanderForce table(p, 3, 25);
-  NeighborGrid none;
+  NeighborLists none;
   const VecX x = VecX::Zero(9), v = VecX::Zero(9);
   double biggest_jump = 0, biggest = 0;
   for (int n = 0; n < 40; ++n)

@@ -36,15 +36,23 @@ TEST(NeighborForces, EqualsTheSeparateTermsForwardAndTransposed) {
   AvoidanceForce avoid({6.0, 1.5});
   MatchingForce match({0.5, 2.5});
   CenteringForce centre({1.0, 3.5});
-  const FlockState s{0, x, v, grid};
+  const FlockState s{0, x, v, grid.lists()};
   centre.prepare(s);
-  VecX offset(3 * p);
+  std::vector<AgentMotion> motion(p);
+  pack_motion(x, v, motion);
+  std::vector<Planar> offset(p);
   std::vector<double> b(p);
   double largest = 0;
   for (int i = 0; i < p; ++i) {
-    Vec3 o, f_ref = Vec3::Zero();
-    const Vec3 f = fused.force(x, v, grid.neighbors(i), i, o, b[i]);
-    seg(offset, i) = o;
+    Vec3 f_ref = Vec3::Zero();
+    const Planar fp = fused.force(motion.data(), grid.neighbors(i), i, offset[i], b[i]);
+    const Vec3 f(fp.x, 0, fp.z);
+    Planar o2;
+    double b2 = 0;
+    fused.centering(motion.data(), grid.neighbors(i), i, o2, b2);
+    EXPECT_EQ(o2.x, offset[i].x);
+    EXPECT_EQ(o2.z, offset[i].z);
+    EXPECT_EQ(b2, b[i]);
     avoid.add_force(s, i, f_ref);
     match.add_force(s, i, f_ref);
     centre.add_force(s, i, f_ref);
@@ -52,9 +60,14 @@ TEST(NeighborForces, EqualsTheSeparateTermsForwardAndTransposed) {
     EXPECT_LT((f - f_ref).norm(), 1e-12 * (1 + f_ref.norm())) << "agent " << i;
   }
   ASSERT_GT(largest, 0.1);
+  std::vector<AgentAdjoint> adjoint(p);
+  for (int i = 0; i < p; ++i)
+    adjoint[i] = {x[3 * i], x[3 * i + 2], v[3 * i], v[3 * i + 2], y[3 * i], y[3 * i + 2], offset[i].x, offset[i].z, 1.0 / b[i]};
   for (int j = 0; j < p; ++j) {
-    Vec3 kt = Vec3::Zero(), dt = Vec3::Zero(), kt_ref = Vec3::Zero(), dt_ref = Vec3::Zero();
-    fused.transpose_apply(x, v, y, grid.neighbors(j), j, offset, b, kt, dt);
+    Vec3 kt_ref = Vec3::Zero(), dt_ref = Vec3::Zero();
+    Planar kp, dp;
+    fused.transpose_apply(adjoint.data(), grid.neighbors(j), j, kp, dp);
+    const Vec3 kt(kp.x, 0, kp.z), dt(dp.x, 0, dp.z);
     avoid.add_KT(s, y, j, kt_ref);
     match.add_KT(s, y, j, kt_ref);
     centre.add_KT(s, y, j, kt_ref);

@@ -48,6 +48,58 @@ std::vector<std::vector<std::pair<int, double>>> line_weights(int n) {
   return w;
 }
 
+// Interpolation rows of an nx x ny grid from its coarser grid; an inactive fine node takes nothing (P's
+// Dirichlet rows). coarse_active: 1 on every coarse node some active fine node takes from.
+WeightedRows interpolation(int nx, int ny, const std::vector<char>& active, std::vector<char>& coarse_active) {
+  const int cx = coarse_count(nx), cy = coarse_count(ny);
+  const auto wx = line_weights(nx), wy = line_weights(ny);
+  std::vector<std::vector<std::pair<int, double>>> parents(nx * ny);
+  coarse_active.assign(cx * cy, 0);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+      if (active[j * nx + i])
+        for (auto [cj, vj] : wy[j])
+          for (auto [ci, vi] : wx[i]) {
+            parents[j * nx + i].push_back({cj * cx + ci, vi * vj});
+            coarse_active[cj * cx + ci] = 1;
+          }
+  return WeightedRows::from(parents);
+}
+
+// Restriction: the transpose of P, gathered per coarse node in fine order.
+WeightedRows transposed(const WeightedRows& P, int nc) {
+  std::vector<std::vector<std::pair<int, double>>> gather(nc);
+  for (int i = 0; i + 1 < int(P.start.size()); ++i)
+    for (int k = P.start[i]; k < P.start[i + 1]; ++k) gather[P.index[k]].push_back({i, P.w[k]});
+  return WeightedRows::from(gather);
+}
+
+// Coarse pattern: (I, J) wherever a fine block (i, j) links a parent of i to a parent of j.
+std::vector<std::vector<int>> coarse_pattern(const BlockSparse3& Af, const WeightedRows& P, int nc) {
+  std::vector<std::vector<int>> cols(nc);
+  for (int c = 0; c < nc; ++c) cols[c].push_back(c);
+  for (int i = 0; i + 1 < int(P.start.size()); ++i)
+    for (int s = Af.row_start(i); s < Af.row_start(i + 1); ++s) {
+      const int j = Af.col(s);
+      for (int a = P.start[i]; a < P.start[i + 1]; ++a)
+        for (int b = P.start[j]; b < P.start[j + 1]; ++b) cols[P.index[a]].push_back(P.index[b]);
+    }
+  return cols;
+}
+
+// Galerkin lists: per coarse slot, the fine slots and weights w_iI w_jJ that sum into it.
+WeightedRows galerkin_lists(const BlockSparse3& Af, const WeightedRows& P, const BlockSparse3& Ac) {
+  std::vector<std::vector<std::pair<int, double>>> terms(Ac.nonzero_blocks());
+  for (int i = 0; i + 1 < int(P.start.size()); ++i)
+    for (int s = Af.row_start(i); s < Af.row_start(i + 1); ++s) {
+      const int j = Af.col(s);
+      for (int a = P.start[i]; a < P.start[i + 1]; ++a)
+        for (int b = P.start[j]; b < P.start[j + 1]; ++b)
+          terms[Ac.find(P.index[a], P.index[b])].push_back({s, P.w[a] * P.w[b]});
+    }
+  return WeightedRows::from(terms);
+}
+
 }  // namespace
 
 WeightedRows WeightedRows::from(const std::vector<std::vector<std::pair<int, double>>>& rows) {
@@ -71,50 +123,13 @@ void GridMultigrid::setup(int nx, int ny, const BlockSparse3& A, const std::vect
   while (levels_.back().nx * levels_.back().ny > kCoarsest && std::min(levels_.back().nx, levels_.back().ny) > 2) {
     Level& f = levels_.back();
     const BlockSparse3& Af = levels_.size() == 1 ? A : f.A_own;
-    const int cx = coarse_count(f.nx), cy = coarse_count(f.ny), nf = f.nx * f.ny, nc = cx * cy;
-    const auto wx = line_weights(f.nx), wy = line_weights(f.ny);
-    // Interpolation rows; an inactive fine node takes nothing (P's Dirichlet rows).
-    std::vector<std::vector<std::pair<int, double>>> parents(nf);
-    std::vector<char> coarse_active(nc, 0);
-    for (int j = 0; j < f.ny; ++j)
-      for (int i = 0; i < f.nx; ++i)
-        if (f.active[j * f.nx + i])
-          for (auto [cj, vj] : wy[j])
-            for (auto [ci, vi] : wx[i]) {
-              parents[j * f.nx + i].push_back({cj * cx + ci, vi * vj});
-              coarse_active[cj * cx + ci] = 1;
-            }
-    f.interp = WeightedRows::from(parents);
-    const WeightedRows& P = f.interp;
-    // Restriction: the transpose, gathered per coarse node in fine order.
-    std::vector<std::vector<std::pair<int, double>>> gather(nc);
-    for (int i = 0; i < nf; ++i)
-      for (int k = P.start[i]; k < P.start[i + 1]; ++k) gather[P.index[k]].push_back({i, P.w[k]});
-    f.restriction = WeightedRows::from(gather);
-    // Coarse pattern: (I, J) wherever a fine block (i, j) links a parent of i to a parent of j.
-    std::vector<std::vector<int>> cols(nc);
-    for (int c = 0; c < nc; ++c) cols[c].push_back(c);
-    for (int i = 0; i < nf; ++i)
-      for (int s = Af.row_start(i); s < Af.row_start(i + 1); ++s) {
-        const int j = Af.col(s);
-        for (int a = P.start[i]; a < P.start[i + 1]; ++a)
-          for (int b = P.start[j]; b < P.start[j + 1]; ++b) cols[P.index[a]].push_back(P.index[b]);
-      }
     Level c;
-    c.nx = cx;
-    c.ny = cy;
-    c.active = coarse_active;
-    c.A_own.set_pattern(cols);
-    // Galerkin lists: per coarse slot, the fine slots and weights w_iI w_jJ that sum into it.
-    std::vector<std::vector<std::pair<int, double>>> terms(c.A_own.nonzero_blocks());
-    for (int i = 0; i < nf; ++i)
-      for (int s = Af.row_start(i); s < Af.row_start(i + 1); ++s) {
-        const int j = Af.col(s);
-        for (int a = P.start[i]; a < P.start[i + 1]; ++a)
-          for (int b = P.start[j]; b < P.start[j + 1]; ++b)
-            terms[c.A_own.find(P.index[a], P.index[b])].push_back({s, P.w[a] * P.w[b]});
-      }
-    f.galerkin = WeightedRows::from(terms);
+    c.nx = coarse_count(f.nx);
+    c.ny = coarse_count(f.ny);
+    f.interp = interpolation(f.nx, f.ny, f.active, c.active);
+    f.restriction = transposed(f.interp, c.nx * c.ny);
+    c.A_own.set_pattern(coarse_pattern(Af, f.interp, c.nx * c.ny));
+    f.galerkin = galerkin_lists(Af, f.interp, c.A_own);
     levels_.push_back(std::move(c));
   }
   for (Level& l : levels_) {

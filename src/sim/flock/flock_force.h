@@ -5,7 +5,7 @@
 // keeps results bit-identical for any thread count. Jacobians are never assembled: the adjoint needs
 // only K^T y and D^T y (K = df/dx, D = df/dv, y a 3p vector), which each term applies matrix-free.
 #include "core/types.h"
-#include "sim/flock/neighbor_grid.h"
+#include "sim/flock/neighbor_lists.h"
 
 namespace kf {
 
@@ -15,7 +15,7 @@ struct FlockState {
   int step;
   const VecX& x;
   const VecX& v;
-  const NeighborGrid& neighbors;
+  const NeighborLists& neighbors;
 };
 
 class FlockForce {

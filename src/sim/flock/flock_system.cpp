@@ -22,6 +22,19 @@ FlockSystem::FlockSystem(const FlockSpec& spec, double h, int steps, unsigned se
   }
   if (spec.drag.strength > 0) local_forces_.push_back(std::make_unique<DragForce>(spec.drag.strength));
   y_.resize(dof());
+  motion_.resize(spec.agents);
+  adjoint_.resize(spec.agents);
+  if (neighbor_forces_.any()) {
+    NeighborLists spawn;
+    grid_.search(spawn_positions(spec_, seed_), neighbor_forces_.radius(), spawn);
+    spawn_entries_ = spawn.entries();
+  }
+}
+
+std::size_t FlockSystem::record_bytes_estimate() const {
+  const std::size_t p = std::size_t(spec_.agents);
+  const std::size_t entries = std::max(2 * std::size_t(spawn_entries_), std::size_t(most_entries_) * 5 / 4);
+  return sizeof(int) * (p + 1 + entries) + 3 * sizeof(double) * p;
 }
 
 void FlockSystem::initial_state(VecX& x, VecX& v) const {
@@ -35,30 +48,44 @@ void FlockSystem::check_size(const VecX& x, const VecX& v) const {
   CHECK_EQ(v.size(), dof());
 }
 
-void FlockSystem::search(FlockRecord& r, const VecX& x, bool with_centering) {
+void FlockSystem::search(FlockRecord& r, const VecX& x, const VecX& v, bool with_centering) {
   const int p = spec_.agents;
-  if (r.offset.size() != dof()) {
-    r.offset.resize(dof());
+  if (int(r.b.size()) != p) {
+    r.offset.resize(p);
     r.b.resize(p);
   }
   if (!neighbor_forces_.any()) {
-    r.offset.setZero();
+    std::fill(r.offset.begin(), r.offset.end(), Planar{});
     std::fill(r.b.begin(), r.b.end(), 1.0);
     return;
   }
-  r.grid.build(x, neighbor_forces_.radius());
-  if (with_centering)
-    parallel_agents(p, [&](int i) {
-      Vec3 o;
-      neighbor_forces_.centering(x, r.grid.neighbors(i), i, o, r.b[i]);
-      seg(r.offset, i) = o;
-    });
+  grid_.search(x, neighbor_forces_.radius(), r.lists);
+  most_entries_ = std::max(most_entries_, r.lists.entries());
+  if (with_centering) {
+    pack_motion(x, v, motion_);
+    parallel_agents(p, [&](int i) { neighbor_forces_.centering(motion_.data(), r.lists.neighbors(i), i, r.offset[i], r.b[i]); });
+  }
+}
+
+void FlockSystem::add_neighbor_force(FlockRecord& r, int i, Vec3& f) const {
+  if (!neighbor_forces_.any()) return;
+  const Planar fn = neighbor_forces_.force(motion_.data(), r.lists.neighbors(i), i, r.offset[i], r.b[i]);
+  f.x() += fn.x;
+  f.z() += fn.z;
+}
+
+void FlockSystem::pack_adjoint(const FlockRecord& r, const VecX& y) {
+  const double c = neighbor_forces_.centering_strength();
+  parallel_agents(spec_.agents, [&](int i) {
+    const AgentMotion& m = motion_[i];
+    adjoint_[i] = {m.x, m.z, m.vx, m.vz, y[3 * i], y[3 * i + 2], r.offset[i].x, r.offset[i].z, c / r.b[i]};
+  });
 }
 
 Vec3 FlockSystem::local_force(int n, const VecX& v, int i) const {
   // Wander and drag read neither neighbours nor x; FlockState is only their calling convention.
-  static const NeighborGrid kNoGrid;
-  const FlockState s{n, v, v, kNoGrid};
+  static const NeighborLists kNone;
+  const FlockState s{n, v, v, kNone};
   Vec3 f = Vec3::Zero();
   for (const auto& force : local_forces_) force->add_force(s, i, f);
   return f;
@@ -68,16 +95,13 @@ bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
                        StepRecord& record) {
   check_size(x, v);
   FlockRecord& r = static_cast<FlockRecord&>(record);
-  search(r, x, false);  // the step fills the centering quantities itself
+  search(r, x, v, false);  // the step fills the centering quantities itself
+  pack_motion(x, v, motion_);
   x_next.resize(dof());
   v_next.resize(dof());
   parallel_agents(spec_.agents, [&](int i) {
     Vec3 f = seg(u, i) + local_force(n, v, i);
-    if (neighbor_forces_.any()) {
-      Vec3 o;
-      f += neighbor_forces_.force(x, v, r.grid.neighbors(i), i, o, r.b[i]);
-      seg(r.offset, i) = o;
-    }
+    add_neighbor_force(r, i, f);
     Vec3 v1 = seg(v, i) + (h_ / masses_[i]) * f;
     v1.y() = 0;
     Vec3 x1 = seg(x, i) + h_ * v1;
@@ -92,10 +116,14 @@ void FlockSystem::transpose_apply(const FlockRecord& r, int n, const VecX& x, co
                                   Vec3& kt, Vec3& dt) const {
   kt.setZero();
   dt.setZero();
-  if (neighbor_forces_.any())
-    neighbor_forces_.transpose_apply(x, v, y, r.grid.neighbors(j), j, r.offset, r.b, kt, dt);
+  if (neighbor_forces_.any()) {
+    Planar k, d;
+    neighbor_forces_.transpose_apply(adjoint_.data(), r.lists.neighbors(j), j, k, d);
+    kt = Vec3(k.x, 0, k.z);
+    dt = Vec3(d.x, 0, d.z);
+  }
   // Local forces only through their interface, so a new one cannot drop out of the adjoint.
-  const FlockState s{n, x, v, r.grid};
+  const FlockState s{n, x, v, r.lists};
   for (const auto& force : local_forces_) {
     force->add_KT(s, y, j, kt);
     force->add_DT(s, y, j, dt);
@@ -113,6 +141,8 @@ void FlockSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX&,
     si.y() = 0;
     seg(y_, i) = si / masses_[i];
   });
+  pack_motion(x, v, motion_);
+  pack_adjoint(r, y_);
   xhat.resize(dof());
   vhat.resize(dof());
   uhat.resize(dof());
@@ -132,22 +162,20 @@ void FlockSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX&,
 
 void FlockSystem::forces(int n, const VecX& x, const VecX& v, VecX& f) {
   check_size(x, v);
-  search(scratch_, x, false);
+  search(scratch_, x, v, false);
+  pack_motion(x, v, motion_);
   f.resize(dof());
   parallel_agents(spec_.agents, [&](int i) {
     Vec3 fi = local_force(n, v, i);
-    if (neighbor_forces_.any()) {
-      Vec3 o;
-      fi += neighbor_forces_.force(x, v, scratch_.grid.neighbors(i), i, o, scratch_.b[i]);
-      seg(scratch_.offset, i) = o;
-    }
+    add_neighbor_force(scratch_, i, fi);
     seg(f, i) = fi;
   });
 }
 
 void FlockSystem::apply_KT_DT(int n, const VecX& x, const VecX& v, const VecX& y, VecX& KTy, VecX& DTy) {
   check_size(x, v);
-  search(scratch_, x, true);
+  search(scratch_, x, v, true);
+  pack_adjoint(scratch_, y);
   KTy.resize(dof());
   DTy.resize(dof());
   parallel_agents(spec_.agents, [&](int j) {

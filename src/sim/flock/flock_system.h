@@ -19,11 +19,13 @@
 
 namespace kf {
 
-// What a flock step found at its state: neighbours and centering quantities (offset 3p, b p).
+// What a flock step found at its state: neighbour lists and centering quantities (offset m_i - x_i in the
+// ground plane, m, and b_i; p each).
 struct FlockRecord final : StepRecord {
-  NeighborGrid grid;
-  VecX offset;
+  NeighborLists lists;
+  std::vector<Planar> offset;
   std::vector<double> b;
+  std::size_t bytes() const { return lists.bytes() + offset.capacity() * sizeof(Planar) + b.capacity() * sizeof(double); }
 };
 
 class FlockSystem final : public System {
@@ -38,6 +40,10 @@ class FlockSystem final : public System {
   void initial_state(VecX& x, VecX& v) const override;
   bool planar() const override { return true; }
   std::unique_ptr<StepRecord> new_record() const override { return std::make_unique<FlockRecord>(); }
+  // Lists (4 bytes per neighbour entry and per agent) and centering quantities (24 bytes per agent). The
+  // entries are twice those at the spawn (agents bunch as they are steered), or a quarter more than the
+  // most any step has found so far, whichever is larger.
+  std::size_t record_bytes_estimate() const override;
   using System::step;
   using System::step_adjoint;
   bool step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next,
@@ -53,10 +59,15 @@ class FlockSystem final : public System {
   void apply_KT_DT(int n, const VecX& x, const VecX& v, const VecX& y, VecX& KTy, VecX& DTy);
 
  private:
-  // Fills `r` for x: neighbour search, and the centering quantities when `with_centering`.
-  void search(FlockRecord& r, const VecX& x, bool with_centering);
+  // Fills `r` for x: neighbour search, and the centering quantities when `with_centering` (then motion_
+  // holds x and v packed).
+  void search(FlockRecord& r, const VecX& x, const VecX& v, bool with_centering);
+  // Forward neighbour pass over motion_ for agent i: adds the force to f, records offset_i and b_i.
+  void add_neighbor_force(FlockRecord& r, int i, Vec3& f) const;
+  // Packs adjoint_ for the transposed pass at the state of r (motion_ packed), applied to y.
+  void pack_adjoint(const FlockRecord& r, const VecX& y);
   void check_size(const VecX& x, const VecX& v) const;
-  // (K^T y)_j and (D^T y)_j of all forces at the state of record r.
+  // (K^T y)_j and (D^T y)_j of all forces at the state of record r (adjoint_ packed for it).
   void transpose_apply(const FlockRecord& r, int n, const VecX& x, const VecX& v, const VecX& y, int j, Vec3& kt,
                        Vec3& dt) const;
   Vec3 local_force(int n, const VecX& v, int i) const;  // wander + drag on agent i
@@ -67,6 +78,11 @@ class FlockSystem final : public System {
   VecX masses_;
   NeighborForces neighbor_forces_;
   std::vector<std::unique_ptr<FlockForce>> local_forces_;  // per-agent terms: wander, drag
+  NeighborGrid grid_;    // search work space, shared by all steps
+  std::vector<AgentMotion> motion_;    // the state being stepped, packed (p)
+  std::vector<AgentAdjoint> adjoint_;  // the same with y and the centering quantities (p)
+  int spawn_entries_ = 0;  // neighbour entries at the initial state
+  int most_entries_ = 0;   // the most any step has found
   FlockRecord scratch_;  // forces() and apply_KT_DT
   VecX y_;  // M^-1 s in the adjoint step
 };

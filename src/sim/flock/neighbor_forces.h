@@ -1,8 +1,10 @@
 #pragma once
 // Avoidance, velocity matching and centering evaluated together in one pass over each agent's
-// neighbour list, forward and transposed: the loop sums each term's pair struct (AvoidancePair,
-// MatchingPair, CenteringPair, defined beside the terms) and scales by the strengths once per agent.
-// The terms' own classes sum the same structs one term at a time (tests/sim/flock_neighbor_forces_test.cpp).
+// neighbour list, forward and transposed: the same pair formulas as the terms' own pair structs
+// (AvoidancePair, MatchingPair, CenteringPair, defined beside the terms), written out in the ground plane
+// (x, z) over agent data packed into one contiguous entry per agent, so a neighbour costs one cache line
+// and no work on the y components, which are zero. Strengths scale each sum once per agent. The terms'
+// own classes sum the same formulas one term at a time in 3D (tests/sim/flock_neighbor_forces_test.cpp).
 //
 // Forward, for agent i: the summed force and the centering quantities offset_i = m_i - x_i (m) and
 // b_i = 1 + sum_j w_ij that the transposed pass needs for every neighbour.
@@ -14,11 +16,24 @@
 
 #include "core/types.h"
 #include "scene/flock_spec.h"
-#include "sim/flock/avoidance_force.h"
-#include "sim/flock/centering_force.h"
-#include "sim/flock/matching_force.h"
 
 namespace kf {
+
+// One agent as the forward pass reads it: position and velocity in the ground plane (m, m/s).
+struct AgentMotion {
+  double x, z, vx, vz;
+};
+
+// One agent as the transposed pass reads it: its motion, y (the vector K^T and D^T are applied to), its
+// centering offset (m) and c / b for centering strength c.
+struct AgentAdjoint {
+  double x, z, vx, vz, yx, yz, ox, oz, c_over_b;
+};
+
+// Planar vectors of the pair loops (x, z).
+struct Planar {
+  double x = 0, z = 0;
+};
 
 class NeighborForces {
  public:
@@ -27,24 +42,26 @@ class NeighborForces {
   // Largest radius of an active term (m); 0 when no term needs neighbours.
   double radius() const { return radius_; }
   bool any() const { return radius_ > 0; }
+  double centering_strength() const { return kc_; }
 
-  // x, v: 3p positions (m) and velocities (m/s); nbrs: neighbours of i. Returns the force on i (N) and
-  // writes offset_i (m) and b_i.
-  Vec3 force(const VecX& x, const VecX& v, std::span<const int> nbrs, int i, Vec3& offset_i, double& b_i) const;
-
-  // y: 3p; offset: 3p, b: p (from force() or centering() at this x). Adds (K^T y)_j to kt, (D^T y)_j to dt.
-  void transpose_apply(const VecX& x, const VecX& v, const VecX& y, std::span<const int> nbrs, int j,
-                       const VecX& offset, const std::vector<double>& b, Vec3& kt, Vec3& dt) const;
+  // a: all agents; nbrs: neighbours of i. Returns the force on i (N) and writes offset_i (m) and b_i.
+  Planar force(const AgentMotion* a, std::span<const int> nbrs, int i, Planar& offset_i, double& b_i) const;
 
   // Only offset_i and b_i (for a transposed pass at a state whose forward pass was not recorded).
-  void centering(const VecX& x, std::span<const int> nbrs, int i, Vec3& offset_i, double& b_i) const;
+  void centering(const AgentMotion* a, std::span<const int> nbrs, int i, Planar& offset_i, double& b_i) const;
+
+  // a: all agents (y, offsets and c/b filled). Returns (K^T y)_j in kt and (D^T y)_j in dt.
+  void transpose_apply(const AgentAdjoint* a, std::span<const int> nbrs, int j, Planar& kt, Planar& dt) const;
 
  private:
-  double ka_, kmatch_, kc_;  // strengths
-  AvoidancePair avoid_;
-  MatchingPair match_;
-  CenteringPair centre_;
+  double ka_, kmatch_, kc_;           // strengths
+  double ra2_, rm2_, rc2_;            // squared radii, 0 for a term that is off
+  double inv_ra2_, inv_rm2_, inv_rc2_;  // 1/R^2 of each term
+  double eps2_;                       // avoidance softening^2 (m^2)
   double radius_ = 0;
 };
+
+// Packs x and v (3p each) into a (p entries, sized by the caller).
+void pack_motion(const VecX& x, const VecX& v, std::vector<AgentMotion>& a);
 
 }  // namespace kf

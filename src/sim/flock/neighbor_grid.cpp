@@ -1,8 +1,10 @@
 #include "sim/flock/neighbor_grid.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 
+#include "core/check.h"
 #include "sim/flock/parallel_agents.h"
 
 namespace kf {
@@ -30,26 +32,29 @@ uint64_t NeighborGrid::bucket_of(int64_t cx, int64_t cz) const {
   return mix(uint64_t(cx) * 0x9E3779B97F4A7C15ULL ^ mix(uint64_t(cz))) & bucket_mask_;
 }
 
-template <class Visit>
-void NeighborGrid::for_each_neighbor(const VecX& x, int i, Visit&& visit) const {
-  const double r2 = radius_ * radius_;
-  const Vec3 xi = seg(x, i);
+int NeighborGrid::gather(int k, double r2, int cap, int* out) const {
+  const int i = sorted_[k];
+  const double xi = sorted_px_[k], zi = sorted_pz_[k];
+  int n = 0;
   for (int64_t dz = -1; dz <= 1; ++dz)
     for (int64_t dx = -1; dx <= 1; ++dx) {
-      const int64_t cx = cell_x_[i] + dx, cz = cell_z_[i] + dz;
+      const int64_t cx = sorted_cx_[k] + dx, cz = sorted_cz_[k] + dz;
       const uint64_t b = bucket_of(cx, cz);
-      for (int k = bucket_start_[b]; k < bucket_start_[b + 1]; ++k) {
-        const int j = sorted_[k];
+      for (int s = bucket_start_[b], e = bucket_start_[b + 1]; s < e; ++s) {
         // Buckets are shared by colliding cells: keep only agents of this exact cell.
-        if (j == i || cell_x_[j] != cx || cell_z_[j] != cz) continue;
-        if ((seg(x, j) - xi).squaredNorm() < r2) visit(j);
+        if (sorted_cx_[s] != cx || sorted_cz_[s] != cz) continue;
+        const double ex = sorted_px_[s] - xi, ez = sorted_pz_[s] - zi;
+        if (ex * ex + ez * ez < r2 && sorted_[s] != i) {
+          if (n < cap) out[n] = sorted_[s];
+          ++n;
+        }
       }
     }
+  return n;
 }
 
-void NeighborGrid::build(const VecX& x, double radius) {
+void NeighborGrid::search(const VecX& x, double radius, NeighborLists& out) {
   const int p = int(x.size() / 3);
-  radius_ = radius;
   if (int(cell_x_.size()) != p) {
     size_t buckets = 1;
     while (buckets < size_t(2 * p)) buckets *= 2;
@@ -59,7 +64,11 @@ void NeighborGrid::build(const VecX& x, double radius) {
     bucket_start_.assign(buckets + 1, 0);
     bucket_cursor_.assign(buckets, 0);
     sorted_.assign(p, 0);
-    neighbor_count_.assign(p, 0);
+    sorted_cx_.assign(p, 0);
+    sorted_cz_.assign(p, 0);
+    sorted_px_.assign(p, 0.0);
+    sorted_pz_.assign(p, 0.0);
+    count_.assign(p, 0);
   }
   const double inv_cell = 1.0 / radius;
   parallel_agents(p, [&](int i) {
@@ -73,27 +82,44 @@ void NeighborGrid::build(const VecX& x, double radius) {
   for (int i = 0; i < p; ++i) ++bucket_start_[bucket_of(cell_x_[i], cell_z_[i]) + 1];
   for (size_t b = 1; b < bucket_start_.size(); ++b) bucket_start_[b] += bucket_start_[b - 1];
   std::copy(bucket_start_.begin(), bucket_start_.end() - 1, bucket_cursor_.begin());
-  for (int i = 0; i < p; ++i) sorted_[bucket_cursor_[bucket_of(cell_x_[i], cell_z_[i])]++] = i;
+  for (int i = 0; i < p; ++i) {
+    const int s = bucket_cursor_[bucket_of(cell_x_[i], cell_z_[i])]++;
+    sorted_[s] = i;
+    sorted_cx_[s] = cell_x_[i];
+    sorted_cz_[s] = cell_z_[i];
+    sorted_px_[s] = x[3 * i];
+    sorted_pz_[s] = x[3 * i + 2];
+  }
 
-  // One pass: each agent writes into its own slab of `capacity_` entries; in the rare step where some
-  // agent has more neighbours than ever before, the slabs grow and the pass runs again.
+  // One pass in bucket order: each agent writes into its own slab of `capacity_` entries; in the rare
+  // search where some agent has more neighbours than ever before, the slabs grow and the pass runs again.
+  const double r2 = radius * radius;
   if (capacity_ == 0) capacity_ = 16;
   for (;;) {
-    if (neighbors_.size() < size_t(p) * capacity_) neighbors_.resize(size_t(p) * capacity_);
-    parallel_agents(p, [&](int i) {
-      int* out = neighbors_.data() + size_t(i) * capacity_;
-      int n = 0;
-      const int cap = capacity_;
-      for_each_neighbor(x, i, [&](int j) {
-        if (n < cap) out[n] = j;
-        ++n;
-      });
-      neighbor_count_[i] = n;
+    if (slab_.size() < size_t(p) * capacity_) slab_.resize(size_t(p) * capacity_);
+    const int cap = capacity_;
+    parallel_agents(p, [&](int k) {
+      const int i = sorted_[k];
+      count_[i] = gather(k, r2, cap, slab_.data() + size_t(i) * cap);
     });
-    const int most = p ? *std::max_element(neighbor_count_.begin(), neighbor_count_.end()) : 0;
+    const int most = p ? *std::max_element(count_.begin(), count_.end()) : 0;
     if (most <= capacity_) break;
     capacity_ = most + most / 2 + 4;
   }
+
+  // Compact the slabs into the lists.
+  out.start_.resize(p + 1);
+  int64_t total = 0;
+  for (int i = 0; i < p; ++i) {
+    out.start_[i] = int(total);
+    total += count_[i];
+  }
+  CHECK_LE(total, int64_t(INT_MAX));
+  out.start_[p] = int(total);
+  out.entries_.resize(size_t(total));
+  parallel_agents(p, [&](int i) {
+    std::copy_n(slab_.data() + size_t(i) * capacity_, count_[i], out.entries_.data() + out.start_[i]);
+  });
 }
 
 }  // namespace kf

@@ -1,44 +1,51 @@
 #pragma once
 // Fixed-radius neighbour lists for agents on the ground plane, by a hashed uniform grid.
 //
-// Cells are `radius` wide in x and z and hashed into a table of ~2p buckets (filled by a counting sort),
-// so memory is linear in agents however far the flock spreads. Cost is linear in agents at bounded
-// density. After the first build with a given p nothing is allocated, except that the per-agent
-// neighbour slabs grow (amortised) if the flock becomes denser than ever before.
+// Cells are `radius` wide in x and z (the kernels' support: a 3 x 3 block of cells holds every
+// neighbour) and hashed into a table of ~2p buckets filled by a counting sort, so memory is linear in
+// agents however far the flock spreads. The agents' cells and x, z coordinates are copied in bucket
+// order, so scanning a cell reads contiguous memory, and agents are visited in that order so nearby
+// agents share cached cells. Cost is linear in agents at bounded density. After the first search with a
+// given p nothing is allocated, except that work space and lists grow (amortised) if the flock becomes
+// denser than ever before.
 #include <cstdint>
 #include <span>
 #include <vector>
 
 #include "core/types.h"
+#include "sim/flock/neighbor_lists.h"
 
 namespace kf {
 
 class NeighborGrid {
  public:
-  // x: 3p positions (m). Afterwards neighbors(i) lists every j != i with |x_i - x_j|^2 < radius^2,
-  // in an order that depends only on x (not on the thread count).
-  void build(const VecX& x, double radius);
+  // x: 3p positions (m; y ignored). Afterwards out.neighbors(i) lists every j != i with
+  // (x_i - x_j)^2 + (z_i - z_j)^2 < radius^2, in an order that depends only on x (not on the thread count).
+  void search(const VecX& x, double radius, NeighborLists& out);
 
-  int agents() const { return int(neighbor_count_.size()); }
-  std::span<const int> neighbors(int i) const {
-    return {neighbors_.data() + size_t(i) * capacity_, size_t(neighbor_count_[i])};
-  }
-  double radius() const { return radius_; }
+  // The same into the grid's own lists.
+  void build(const VecX& x, double radius) { search(x, radius, lists_); }
+  const NeighborLists& lists() const { return lists_; }
+  int agents() const { return lists_.agents(); }
+  std::span<const int> neighbors(int i) const { return lists_.neighbors(i); }
 
  private:
-  template <class Visit>
-  void for_each_neighbor(const VecX& x, int i, Visit&& visit) const;
   uint64_t bucket_of(int64_t cx, int64_t cz) const;
+  // Writes agent sorted_[k]'s neighbours (up to `cap`) to out; returns how many it has.
+  int gather(int k, double r2, int cap, int* out) const;
 
-  double radius_ = 0;
   uint64_t bucket_mask_ = 0;
   std::vector<int64_t> cell_x_, cell_z_;  // per agent
   std::vector<int> bucket_start_;         // buckets + 1
   std::vector<int> bucket_cursor_;        // buckets
-  std::vector<int> sorted_;               // agents ordered by bucket
-  std::vector<int> neighbor_count_;       // per agent
-  int capacity_ = 0;                      // neighbour slots per agent
-  std::vector<int> neighbors_;            // p slabs of capacity_ entries
+  // Per slot of the bucket order: the agent, its cell and its x and z.
+  std::vector<int> sorted_;
+  std::vector<int64_t> sorted_cx_, sorted_cz_;
+  std::vector<double> sorted_px_, sorted_pz_;
+  std::vector<int> count_;  // neighbours per agent
+  int capacity_ = 0;        // slab entries per agent
+  std::vector<int> slab_;   // p slabs of capacity_ entries, compacted into the lists
+  NeighborLists lists_;
 };
 
 }  // namespace kf

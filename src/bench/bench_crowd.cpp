@@ -1,0 +1,137 @@
+// Crowd sweep: the square-then-cross figure scaled to more agents at the paper's density, optimised for a
+// fixed number of evaluations in a fresh process per size: time per evaluation, whole optimisation and
+// peak resident memory against agents.
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+
+#include "bench/bench_crowd.h"
+#include "bench/bench_point.h"
+#include "bench/bench_sweeps.h"
+#include "report/plot.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+
+namespace kf {
+
+namespace {
+
+// The scene file `base` with `agents` agents: spawn disc (centre and radius) and every shape's polygon
+// scaled by sqrt(agents / base agents) about the origin, so the density stays the figure's; coverage terms
+// dropped (their cost is not linear in the agents).
+nlohmann::json scaled_scene(const nlohmann::json& base, int agents) {
+  nlohmann::json s = base;
+  const double k = std::sqrt(double(agents) / base["flock"]["agents"].get<double>());
+  s["flock"]["agents"] = agents;
+  auto& spawn = s["flock"]["spawn"];
+  spawn["radius"] = spawn["radius"].get<double>() * k;
+  if (spawn.contains("center"))
+    for (auto& c : spawn["center"]) c = c.get<double>() * k;
+  for (auto& o : s["objectives"]) {
+    if (o.contains("polygon"))
+      for (auto& pt : o["polygon"])
+        for (auto& c : pt) c = c.get<double>() * k;
+    o.erase("coverage");
+  }
+  return s;
+}
+
+struct ChildRun {
+  double wall_s = 0;
+  long peak_kb = 0;
+  int status = 0;
+};
+
+// Runs `argv` in a fresh process; its peak resident set from wait4.
+ChildRun run_child(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  const auto t0 = std::chrono::steady_clock::now();
+  const pid_t pid = fork();
+  if (pid < 0) throw OutputError("bench: cannot fork");
+  if (pid == 0) {
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  int status = 0;
+  rusage ru{};
+  if (wait4(pid, &status, 0, &ru) != pid) throw OutputError("bench: lost the child " + args[0]);
+  ChildRun r;
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.peak_kb = ru.ru_maxrss;
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return r;
+}
+
+}  // namespace
+
+nlohmann::json bench_crowd(const CrowdSweepOptions& o, const std::filesystem::path& out,
+                           const std::filesystem::path& self) {
+  std::ifstream in(o.scene);
+  if (!in) throw InputError(o.scene.string() + ": cannot read the crowd sweep's scene");
+  const nlohmann::json base = nlohmann::json::parse(in);
+  const std::filesystem::path work = out / "crowd";
+  ensure_directory(work);
+  CsvTable t({"agents", "control_variables", "steps", "max_memory_gb", "checkpoint_every", "evaluations",
+              "optimize_s", "s_per_evaluation", "peak_mb", "bytes_per_agent_step", "inside_first", "inside_second",
+              "status"});
+  std::vector<double> n, te, pk;
+  nlohmann::json points = nlohmann::json::array();
+  std::vector<std::pair<int, double>> sizes;
+  for (int a : o.agents) sizes.emplace_back(a, 0.0);
+  for (int a : o.budget_agents) sizes.emplace_back(a, o.budget_gb);
+  for (const auto& [agents, max_gb] : sizes) {
+    const std::string name = "square-" + std::to_string(agents) + (max_gb > 0 ? "-budget" : "");
+    const auto scene = work / (name + ".json");
+    write_file_atomic(scene, scaled_scene(base, agents).dump(1) + "\n");
+    const auto run = work / name;
+    std::cerr << "bench crowd: " << agents << " agents" << (max_gb > 0 ? ", budget " + fmt(max_gb) + " GB" : "")
+              << std::endl;
+    std::vector<std::string> args = {self.string(), "optimize", scene.string(), "--out", run.string(),
+                                     "--max-evaluations", std::to_string(o.evaluations), "--quiet"};
+    if (max_gb > 0) {
+      args.push_back("--max-memory");
+      args.push_back(fmt(max_gb));
+    }
+    const ChildRun c = run_child(args);
+    std::ifstream rin(run / "report.json");
+    if (!rin) throw OutputError("bench crowd: " + name + " wrote no report (exit " + std::to_string(c.status) + ")");
+    const nlohmann::json rep = nlohmann::json::parse(rin);
+    const int evals = rep["evaluations"], steps = rep["steps"];
+    const double secs = rep["wall_seconds"];
+    const auto& m = rep["measures"];
+    auto inside = [&](size_t k) { return k < m.size() && m[k].contains("inside_fraction") ? fmt(m[k]["inside_fraction"]) : ""; };
+    const double per_agent_step = 1024.0 * double(c.peak_kb) / (double(agents) * steps);
+    t.add({std::to_string(agents), std::to_string(rep["control_variables"].get<long>()), std::to_string(steps),
+           fmt(rep["memory_budget_gb"]), std::to_string(rep["checkpoint_every_for_budget"].get<int>()),
+           std::to_string(evals), fmt(secs), fmt(secs / std::max(evals, 1)), fmt(c.peak_kb / 1024.0),
+           fmt(per_agent_step), inside(0), inside(1), std::to_string(c.status)});
+    points.push_back({{"agents", agents}, {"max_memory_gb", max_gb}, {"exit", c.status}, {"report", rep}});
+    if (max_gb == 0) {
+      n.push_back(agents);
+      te.push_back(secs / std::max(evals, 1));
+      pk.push_back(c.peak_kb / 1024.0);
+    }
+  }
+  const auto csv = out / "flock_crowd.csv";
+  t.write(csv);
+  plot_csv(csv, out / "flock_crowd_time.png", "crowd: seconds per evaluation and whole optimisation against agents",
+           t.col("agents"), {t.col("s_per_evaluation"), t.col("optimize_s")}, true, true);
+  plot_csv(csv, out / "flock_crowd_memory.png", "crowd: peak resident MB against agents", t.col("agents"),
+           {t.col("peak_mb")}, true, true);
+  nlohmann::json j = {{"table", t.excerpt()},
+                      {"evaluation_exponent", fitted_exponent(n, te)},
+                      {"memory_exponent", fitted_exponent(n, pk)},
+                      {"points", points}};
+  std::cout << "flock_crowd.csv\n" << t.excerpt() << "fitted exponent: per evaluation " << fmt(j["evaluation_exponent"])
+            << ", peak memory " << fmt(j["memory_exponent"]) << "\n" << std::endl;
+  return j;
+}
+
+}  // namespace kf

@@ -1,0 +1,25 @@
+#pragma once
+// The crowd sweep of `keyframe bench --only flock`: a figure scene scaled to more agents at its density and
+// optimised in a fresh process per point, so each point's peak memory is its own.
+#include <filesystem>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace kf {
+
+struct CrowdSweepOptions {
+  std::filesystem::path scene = "scenes/square.json";  // a flock scene with shape keyframes
+  std::vector<int> agents{200, 1000, 3000, 10000, 30000, 100000};
+  int evaluations = 60;
+  // Sizes run again with a memory budget of budget_gb (GB), which switches checkpointing on.
+  std::vector<int> budget_agents{10000};
+  double budget_gb = 0.7;
+};
+
+// Writes <out>/flock_crowd.csv, flock_crowd_time.png, flock_crowd_memory.png and the runs under <out>/crowd/
+// (`self` is this executable). Points run in the order given, budgeted ones after the others.
+nlohmann::json bench_crowd(const CrowdSweepOptions& o, const std::filesystem::path& out,
+                           const std::filesystem::path& self);
+
+}  // namespace kf
