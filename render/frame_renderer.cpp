@@ -3,7 +3,9 @@
 #include <fstream>
 
 #include "core/error.h"
+#include "core/file_name.h"
 #include "core/overloaded.h"
+#include "scene/run_name.h"
 
 namespace kf::render {
 
@@ -19,7 +21,10 @@ RunData load_run(const fs::path& run_dir) {
   if (run.trajectory.particles != run.scene.particles())
     throw InputError(d + ": trajectory.bin has " + std::to_string(run.trajectory.particles) +
                      " particles but scene.json describes " + std::to_string(run.scene.particles()));
-  if (run.trajectory.frames() == 0) throw InputError(d + ": trajectory.bin holds no frames");
+  if (run.trajectory.frames() != run.scene.time.frames + 1)
+    throw InputError(d + "/trajectory.bin: holds " + std::to_string(run.trajectory.frames()) +
+                     " frames but scene.json describes " + std::to_string(run.scene.time.frames + 1) +
+                     " (frames 0.." + std::to_string(run.scene.time.frames) + ")");
   if (fs::exists(run_dir / "meshes.bin")) {
     run.meshes = load_mesh_sequence(run_dir / "meshes.bin");
     if (run.meshes->frames() != run.trajectory.frames())
@@ -27,13 +32,12 @@ RunData load_run(const fs::path& run_dir) {
                        " frames but trajectory.bin has " + std::to_string(run.trajectory.frames()));
   }
   // The run keeps the original scene's name beside its copy; without it the directory names the run.
-  std::ifstream names(run_dir / "scene_name.txt");
-  std::string name;
-  if (std::getline(names, name) && !name.empty())
-    run.scene.name = name;
+  if (const auto names = read_run_name(run_dir))
+    run.scene.name = names->name;
   else
     run.scene.name = fs::absolute(run_dir).lexically_normal().filename().string();
   if (run.scene.name.empty()) run.scene.name = fs::absolute(run_dir).lexically_normal().parent_path().filename().string();
+  if (!file_name_problem(run.scene.name).empty()) run.scene.name = "run";
   return run;
 }
 

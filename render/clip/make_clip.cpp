@@ -12,6 +12,7 @@
 #include <set>
 
 #include "core/error.h"
+#include "render/image/png_io.h"
 
 extern char** environ;
 
@@ -117,6 +118,19 @@ std::vector<fs::path> make_clip(const ClipRequest& r) {
     throw InputError(frames.string() + ": frames " + std::to_string(first) + ".." + std::to_string(last) +
                      " are followed by a gap (frame " + std::to_string(last + 1) +
                      " is missing); re-render the frames without gaps");
+  // ffmpeg skips a frame it cannot decode and still exits 0; every frame is read here first instead.
+  int width = 0, height = 0;
+  char name[64];
+  for (int k = first; k <= last; ++k) {
+    std::snprintf(name, sizeof name, "_%04d.png", k);
+    const fs::path file = frames / (stem + name);
+    const Image img = read_png(file);
+    if (k == first) width = img.width, height = img.height;
+    if (img.width != width || img.height != height)
+      throw InputError(file.string() + ": " + std::to_string(img.width) + "x" + std::to_string(img.height) +
+                       " pixels, but frame " + std::to_string(first) + " has " + std::to_string(width) + "x" +
+                       std::to_string(height) + "; re-render the frames at one size");
+  }
   const fs::path ffmpeg = find_program(r.ffmpeg);
   if (ffmpeg.empty()) throw OutputError("clip: cannot run \"" + r.ffmpeg + "\"");
   const double fps = r.fps > 0.0 ? r.fps : trajectory_fps(r.run_dir);

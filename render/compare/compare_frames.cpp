@@ -119,15 +119,20 @@ CompareResult compare_frames(const CompareRequest& r) {
   for (const auto& n : names) {
     FrameResult f;
     f.name = n;
+    // Sizes from the headers first: a mismatch is reported before a large image is decoded.
+    const PngHeader ha = read_png_header(actual / n);
+    if (ref_names.count(n)) {
+      const PngHeader hb = read_png_header(reference / n);
+      if (ha.width != hb.width || ha.height != hb.height)
+        throw InputError((actual / n).string() + ": " + std::to_string(ha.width) + "x" + std::to_string(ha.height) +
+                         " pixels, but the reference " + (reference / n).string() + " has " +
+                         std::to_string(hb.width) + "x" + std::to_string(hb.height));
+    }
     const Image a = read_png(actual / n);
     f.width = a.width;
     f.height = a.height;
     if (ref_names.count(n)) {
       const Image b = read_png(reference / n);
-      if (a.width != b.width || a.height != b.height)
-        throw InputError((actual / n).string() + ": " + std::to_string(a.width) + "x" + std::to_string(a.height) +
-                         " pixels, but the reference " + (reference / n).string() + " has " +
-                         std::to_string(b.width) + "x" + std::to_string(b.height));
       f.metrics = image_metrics(a, b, t.tolerance);
       f.why = threshold_failure(f.metrics, t);
     } else {

@@ -11,9 +11,11 @@
 #include <memory>
 
 #include "core/atomic_file.h"
+#include "core/dir_lock.h"
 #include "core/error.h"
 #include "core/overloaded.h"
 #include "render/export/animated_gltf.h"
+#include "render/export/checked_io.h"
 #include "render/export/point_cache.h"
 #include "render/frame_renderer.h"
 
@@ -194,6 +196,8 @@ std::vector<fs::path> export_run(const ExportRequest& r) {
     throw InputError("frames " + std::to_string(begin) + ":" + std::to_string(r.frame_end) + " out of range: " +
                      r.run_dir.string() + " has frames 0.." + std::to_string(F - 1) + " (A:B exports A..B-1)");
   Assimp::Exporter exporter;
+  auto* io = new CheckedIOSystem;  // the exporter owns it
+  exporter.SetIOHandler(io);
   if (format->layout == Layout::kPerFrame) {
     bool available = false;
     for (size_t k = 0; k < exporter.GetExportFormatCount(); ++k)
@@ -201,6 +205,7 @@ std::vector<fs::path> export_run(const ExportRequest& r) {
     if (!available) throw InputError(std::string("this assimp has no \"") + format->assimp_id + "\" exporter");
   }
 
+  const DirLock lock(r.run_dir, DirLock::Mode::kShared);  // no optimisation replaces the run meanwhile
   const fs::path dir = r.run_dir / "export";
   const fs::path partial = dir / (".partial_" + std::to_string(::getpid()));
   std::error_code ec;
@@ -217,6 +222,9 @@ std::vector<fs::path> export_run(const ExportRequest& r) {
         if (exporter.Export(make_scene(frame_meshes(run, f, bounds, g)).get(), format->assimp_id,
                             (partial / file).string()) != aiReturn_SUCCESS)
           throw OutputError((dir / file).string() + ": export failed (" + exporter.GetErrorString() + ")");
+        if (!io->first_error().empty()) throw OutputError(io->first_error());
+        if (std::error_code missing; !fs::is_regular_file(partial / file, missing))
+          throw OutputError((dir / file).string() + ": export failed (assimp wrote no file)");
       }
     } else {
       const std::vector<MovingMesh> objects = moving_meshes(r.run_dir, run, begin, end, bounds, g);
@@ -230,6 +238,11 @@ std::vector<fs::path> export_run(const ExportRequest& r) {
         }
       }
     }
+  } catch (const OutputError& e) {
+    fs::remove_all(partial, ec);
+    std::string message = e.what();  // name the export folder, not its hidden partial copy
+    if (message.rfind(partial.string(), 0) == 0) message.replace(0, partial.string().size(), dir.string());
+    throw OutputError(message);
   } catch (...) {
     fs::remove_all(partial, ec);
     throw;

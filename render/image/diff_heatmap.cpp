@@ -27,7 +27,10 @@ Image diff_heatmap(const Image& a, const Image& b, int tolerance) {
   for (int y = 0; y < a.height; ++y)
     for (int x = 0; x < a.width; ++x) {
       int worst = 0;
-      for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(int(a.at(x, y)[c]) - int(b.at(x, y)[c])));
+      for (int c = 0; c < 4; ++c) {  // alpha too (a missing one is opaque), as image_metrics counts it
+        const int va = c < a.channels ? a.at(x, y)[c] : 255, vb = c < b.channels ? b.at(x, y)[c] : 255;
+        worst = std::max(worst, std::abs(va - vb));
+      }
       uint8_t* o = out.at(x, y);
       if (worst == 0) continue;
       if (worst <= tolerance) {

@@ -13,11 +13,15 @@ ImageMetrics image_metrics(const Image& a, const Image& b, int tolerance) {
   ImageMetrics m;
   // Integer sums are exact (255^2 x 3 x 4096^2 fits easily), so metrics do not depend on summation order.
   long long sum = 0, sum_sq = 0, over = 0;
+  // Alpha counts in each pixel's largest difference when either image has one (a missing alpha is opaque),
+  // so a transparent frame does not pass against an opaque one; the means stay over colour.
+  const bool alpha = a.channels == 4 || b.channels == 4;
   for (int y = 0; y < a.height; ++y) {
     const uint8_t* pa = a.at(0, y);
     const uint8_t* pb = b.at(0, y);
     for (int x = 0; x < a.width; ++x, pa += a.channels, pb += b.channels) {
       int worst = 0;
+      if (alpha) worst = std::abs((a.channels == 4 ? pa[3] : 255) - (b.channels == 4 ? pb[3] : 255));
       for (int c = 0; c < 3; ++c) {
         const int e = std::abs(int(pa[c]) - int(pb[c]));
         sum += e;

@@ -49,7 +49,11 @@ void write_png(const std::filesystem::path& path, const Image& image) {
   write_file_atomic(path, bytes);
 }
 
-Image read_png(const std::filesystem::path& path) {
+namespace {
+// Opens `path`, checks the signature and reads the header; `body(png, info)` then decodes. Frees libpng's
+// state on every path; libpng's errors become InputError naming the file.
+template <typename Body>
+auto with_png_reader(const std::filesystem::path& path, Body body) {
   std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "rb"), std::fclose);
   if (!f) throw InputError(path.string() + ": cannot open PNG");
   unsigned char sig[8];
@@ -58,7 +62,7 @@ Image read_png(const std::filesystem::path& path) {
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &reason, quiet_error, quiet_warning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!png || !info) throw InputError(path.string() + ": cannot start PNG decoder");
-  Image img;
+  decltype(body(png, info)) result{};
   if (setjmp(png_jmpbuf(png))) {
     png_destroy_read_struct(&png, &info, nullptr);
     throw InputError(path.string() + ": corrupt or truncated PNG (" + (reason.empty() ? "libpng error" : reason) + ")");
@@ -66,16 +70,46 @@ Image read_png(const std::filesystem::path& path) {
   png_init_io(png, f.get());
   png_set_sig_bytes(png, 8);
   png_read_info(png, info);
-  png_set_strip_16(png);
-  png_set_palette_to_rgb(png);
-  png_set_expand_gray_1_2_4_to_8(png);
-  png_set_gray_to_rgb(png);
-  png_read_update_info(png, info);
-  const int channels = png_get_channels(png, info);
-  img = Image(int(png_get_image_width(png, info)), int(png_get_image_height(png, info)), channels);
-  for (int y = 0; y < img.height; ++y) png_read_row(png, img.at(0, y), nullptr);
-  png_read_end(png, nullptr);
+  // The header's size is checked before anything is allocated for the rows.
+  const uint32_t w = png_get_image_width(png, info), h = png_get_image_height(png, info);
+  if (w > kMaxPngSide || h > kMaxPngSide || uint64_t(w) * h > kMaxPngPixels) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    throw InputError(path.string() + ": " + std::to_string(w) + "x" + std::to_string(h) +
+                     " pixels, larger than keyframe reads (at most " + std::to_string(kMaxPngSide) +
+                     " a side and " + std::to_string(kMaxPngPixels) + " pixels)");
+  }
+  result = body(png, info);
   png_destroy_read_struct(&png, &info, nullptr);
+  return result;
+}
+}  // namespace
+
+PngHeader read_png_header(const std::filesystem::path& path) {
+  return with_png_reader(path, [](png_structp png, png_infop info) {
+    return PngHeader{int(png_get_image_width(png, info)), int(png_get_image_height(png, info))};
+  });
+}
+
+Image read_png(const std::filesystem::path& path) {
+  // The image lives outside the reader so that libpng's longjmp on a corrupt row skips no destructor.
+  Image img;
+  std::vector<png_bytep> rows;
+  with_png_reader(path, [&](png_structp png, png_infop info) {
+    png_set_strip_16(png);
+    png_set_palette_to_rgb(png);
+    png_set_expand_gray_1_2_4_to_8(png);
+    png_set_tRNS_to_alpha(png);  // a transparent colour or palette entry becomes an alpha channel
+    png_set_gray_to_rgb(png);
+    png_set_interlace_handling(png);  // Adam7: libpng assembles the seven passes
+    png_read_update_info(png, info);
+    const int channels = png_get_channels(png, info);
+    img = Image(int(png_get_image_width(png, info)), int(png_get_image_height(png, info)), channels);
+    rows.resize(size_t(img.height));
+    for (int y = 0; y < img.height; ++y) rows[size_t(y)] = img.at(0, y);
+    png_read_image(png, rows.data());
+    png_read_end(png, nullptr);
+    return 0;
+  });
   return img;
 }
 

@@ -17,7 +17,19 @@ struct Image {
 
 // Throws OutputError when the file cannot be written; nothing is left behind.
 void write_png(const std::filesystem::path& path, const Image& image);
-// Throws InputError when the file is missing or not a PNG. Returns RGB or RGBA.
+// The largest PNG keyframe reads: 16384 pixels a side, 8192 x 8192 pixels in all (256 MiB as RGBA).
+constexpr uint32_t kMaxPngSide = 16384;
+constexpr uint64_t kMaxPngPixels = uint64_t(8192) * 8192;
+
+struct PngHeader {
+  int width = 0, height = 0;
+};
+
+// Throws InputError when the file is missing, not a PNG, or larger than the limits above (checked on the
+// header, before anything is allocated). Returns RGB, or RGBA when the file has alpha or a transparent
+// colour; interlaced (Adam7) files are assembled.
 Image read_png(const std::filesystem::path& path);
+// The size from the header alone (same checks as read_png up to the pixels).
+PngHeader read_png_header(const std::filesystem::path& path);
 
 }  // namespace kf::render

@@ -118,7 +118,9 @@ void backward(System& sys, const Rollout& r, const StepControl& u, const StateCo
               const StepControlGradient& du, VecX& dx0, VecX& dv0, int first) {
   const int N = r.steps(), dof = int(r.x[0].size());
   first = std::clamp(first, 0, N);
-  const int every = r.every > 0 ? r.every : N + 1;
+  // A spacing past the end means one segment of N steps: buffers of N + 1 states, not of `every` (a spacing
+  // of 10^7 on a 10-step run would otherwise ask for 10^7 states).
+  const int every = r.every > 0 ? std::min(r.every, std::max(N, 1)) : N + 1;
   VecX xhat = VecX::Zero(dof), vhat = VecX::Zero(dof), xhat_prev(dof), vhat_prev(dof), uhat(dof);
   if (cost.active(N)) cost.eval(N, r.x[N], r.v[N], xhat, vhat);
   // Segment buffers: states k .. e of the segment being walked back and its tape (checkpointed mode only).

@@ -5,6 +5,7 @@
 #include "adjoint/rollout.h"
 #include "app/commands.h"
 #include "app/body_meshes.h"
+#include "app/memory_budget.h"
 #include "app/run_dir.h"
 #include "core/error.h"
 #include "core/progress.h"
@@ -12,18 +13,26 @@
 #include "sim/make_system.h"
 
 namespace kf {
+namespace fs = std::filesystem;
 
 void add_simulate_command(CLI::App& app) {
   auto* sub = app.add_subcommand("simulate", "run the scene forward without controls and save the trajectory");
   auto scene_path = std::make_shared<std::string>();
   auto out = std::make_shared<std::string>();
   sub->add_option("SCENE", *scene_path, "scene file (JSON)")->required();
+  auto max_memory = std::make_shared<std::string>();
   sub->add_option("--out", *out, "run directory (default: out/<scene>/)");
+  sub->add_option("--max-memory", *max_memory,
+                  "refuse the run up front when its estimated memory exceeds this (e.g. 4G; default: the "
+                  "machine's memory)");
   sub->callback([=] {
     Scene scene = load_scene(*scene_path);
     if (scene.cloth) scene.cloth->use_motion_tolerance();
+    // Before the system is built: a run too large to hold is refused at once.
+    check_memory(scene, simulate_memory(scene), max_memory->empty() ? 0 : parse_memory_size(*max_memory));
     auto sys = make_system(scene);
     const auto dir = run_dir_for(scene, *out);
+    StagedDir staged(dir);  // locks an existing run directory before the work starts
     VecX x0, v0;
     sys->initial_state(x0, v0);
     Rollout r;
@@ -33,14 +42,16 @@ void add_simulate_command(CLI::App& app) {
     if (!ok)
       throw InputError(scene.file.string() + ": the simulation diverged at step " + std::to_string(r.diverged_at) +
                        " (reduce the time step or the stiffness)");
-    prepare_run_dir(dir, scene);
-    save_trajectory(dir / "trajectory.bin", frames_of(r, scene.time, sys->particles()));
-    write_body_meshes(scene, scene.time.frames + 1, dir / "meshes.bin");
-    nlohmann::json report = {{"scene", scene.name}, {"command", "simulate"}, {"system", sys->describe()},
-                             {"steps", scene.time.steps()}, {"frames", scene.time.frames + 1},
-                             {"simulate_seconds", secs}};
-    for (const auto& [name, value] : sys->run_stats()) report["run_stats"][name] = value;
-    write_json(dir / "report.json", report);
+    commit_run_dir(staged, [&](const fs::path& work) {
+      prepare_run_dir(work, scene);
+      save_trajectory(work / "trajectory.bin", frames_of(r, scene.time, sys->particles()));
+      write_body_meshes(scene, scene.time.frames + 1, work / "meshes.bin");
+      nlohmann::json report = {{"scene", scene.name}, {"command", "simulate"}, {"system", sys->describe()},
+                               {"steps", scene.time.steps()}, {"frames", scene.time.frames + 1},
+                               {"simulate_seconds", secs}};
+      for (const auto& [name, value] : sys->run_stats()) report["run_stats"][name] = value;
+      write_json(work / "report.json", report);
+    });
     std::cout << "simulated " << scene.time.steps() << " steps of " << sys->describe() << " in " << secs
               << " s -> " << (dir / "trajectory.bin").string() << "\n";
   });

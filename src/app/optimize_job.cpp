@@ -11,6 +11,7 @@
 #include "adjoint/memory_estimate.h"
 #include "adjoint/rollout.h"
 #include "app/body_meshes.h"
+#include "app/memory_budget.h"
 #include "report/plot.h"
 #include "app/run_dir.h"
 #include "core/atomic_file.h"
@@ -32,17 +33,17 @@ namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop = true; }
 
-// Installs SIGINT/SIGTERM handlers for its lifetime.
+// Installs handlers for the signals that ask a job to stop (Ctrl-C, kill, a closed terminal, Ctrl-\\) for
+// its lifetime: each saves the best controls so far, as SIGINT does.
 struct SignalGuard {
-  void (*old_int)(int), (*old_term)(int);
+  static constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+  void (*old[4])(int);
   SignalGuard() {
     g_stop = false;
-    old_int = std::signal(SIGINT, on_signal);
-    old_term = std::signal(SIGTERM, on_signal);
+    for (int k = 0; k < 4; ++k) old[k] = std::signal(kSignals[k], on_signal);
   }
   ~SignalGuard() {
-    std::signal(SIGINT, old_int);
-    std::signal(SIGTERM, old_term);
+    for (int k = 0; k < 4; ++k) std::signal(kSignals[k], old[k]);
   }
 };
 
@@ -106,7 +107,8 @@ class EvaluationLog {
 // One stage of the schedule: L-BFGS from z within spec.max_evaluations, then up to `restarts` fresh starts
 // from the best point after a stalled line search, with what is left of the budget, while they make progress.
 OptimizeResult run_stage(Problem& problem, OptimizerSpec spec, int restarts, const VecX& z, int stage_id,
-                         int substeps, double seconds_before, EvaluationLog& elog, Progress& progress) {
+                         int substeps, double seconds_before, EvaluationLog& elog, Progress& progress,
+                         EvaluationTape& tape) {
   const int budget = spec.max_evaluations;
   int used = 0;       // evaluations of the earlier starts of this stage
   double before = 0;  // and their seconds
@@ -116,7 +118,7 @@ OptimizeResult run_stage(Problem& problem, OptimizerSpec spec, int restarts, con
     r.seconds += before;
     elog.record(stage_id, substeps, seconds_before, r, progress);
   };
-  OptimizeResult res = minimize(problem, spec, z, on_eval, &g_stop);
+  OptimizeResult res = minimize(problem, spec, z, on_eval, &g_stop, &tape);
   for (int k = 0; k < restarts && !res.interrupted; ++k) {
     const int left = budget - int(res.history.size());
     if (res.status.rfind("stopped: line search", 0) != 0 || left < 3) break;
@@ -127,7 +129,7 @@ OptimizeResult run_stage(Problem& problem, OptimizerSpec spec, int restarts, con
     used = int(res.history.size());
     const VecX best = res.z;
     const double best_phi = res.phi;
-    OptimizeResult more = minimize(problem, spec, best, on_eval, &g_stop);
+    OptimizeResult more = minimize(problem, spec, best, on_eval, &g_stop, &tape);
     more.seconds += before;
     more.evaluations += res.evaluations;
     more.history.insert(more.history.begin(), res.history.begin(), res.history.end());
@@ -187,6 +189,7 @@ RunFacts run_facts(const std::string& status, const std::vector<HistoryRow>& his
 
 // What the stages leave behind.
 struct JobResult {
+  EvaluationTape tape;  // every evaluation, for a resume that continues exactly where this run stopped
   VecX z;        // the best controls of the last stage
   TimeSpec time;  // its time discretisation
   std::unique_ptr<System> sys;
@@ -243,6 +246,9 @@ nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, size_t 
   const double final_objective = problem.evaluate(job.z, nullptr);
   const Trajectory frames = frames_of(problem.rollout(), job.time, sys.particles());
   save_controls(dir / "controls.bin", job.z, job.time.substeps);
+  std::error_code ec;
+  if (job.tape.complete()) save_evaluations(dir / "evaluations.bin", job.tape.records());
+  else fs::remove(dir / "evaluations.bin", ec);  // too large to keep: a resume restarts from controls.bin
   save_trajectory(dir / "trajectory.bin", frames);
   write_body_meshes(scene, frames.frames(), dir / "meshes.bin");
   const auto& history = elog.history();
@@ -263,6 +269,7 @@ nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, size_t 
                            {"adjoint", scene.optimizer.adjoint},
                            {"stages", stages},
                            {"resumed", resuming},
+                           {"replayed_evaluations", job.tape.replayed()},
                            {"status", job.status},
                            {"interrupted", job.interrupted},
                            {"evaluations", job.evaluations},
@@ -314,6 +321,16 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (opt.max_seconds >= 0) scene.optimizer.max_seconds = opt.max_seconds;
   const fs::path dir = resuming ? fs::path(opt.resume) : run_dir_for(scene, opt.out);
 
+  // A run that cannot fit in the machine's memory even at the checkpoint spacing that needs least (the
+  // memory budget below picks its spacing itself unless --checkpoint-every sets one) is refused before the
+  // stages are planned: planning a sensitive cloth simulates it once.
+  const auto least_memory = [&](int substeps) {
+    const int every = opt.checkpoint_every > 0
+                          ? opt.checkpoint_every
+                          : std::max(1, int(std::sqrt(double(scene.time.frames) * substeps)));
+    return optimize_memory(scene, substeps, every);
+  };
+  check_memory(scene, least_memory(scene.time.substeps), 0);
   // The stages of coarse-to-fine continuation; a resumed run continues in the last stage.
   const StagePlan plan = plan_stages(scene);
   std::vector<StageSpec> stages = plan.stages;
@@ -321,16 +338,34 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     for (auto& s : stages) s.max_evaluations = opt.max_evaluations;
   JobResult job;
   TimeSpec z_time = scene.time;
-  if (resuming) {
+  // A run that kept its evaluations resumes by replaying them from the start (the same path, budget and
+  // result as if it had not stopped); an older one continues its last stage from controls.bin.
+  const bool replaying = resuming && fs::exists(dir / "evaluations.bin");
+  if (replaying) {
+    job.tape.set_replay(load_evaluations(dir / "evaluations.bin"));
+  } else if (resuming) {
     job.z = load_controls(dir / "controls.bin", &z_time.substeps);
     stages.erase(stages.begin(), stages.end() - 1);
+  }
+  {
+    RunMemory need;
+    for (const auto& st : stages) {
+      const RunMemory e = least_memory(st.substeps);
+      if (e.bytes > need.bytes) need = e;
+    }
+    check_memory(scene, need, 0);
   }
   // Build the first system before writing anything, so bad scenes leave no trace.
   TimeSpec& time = job.time;
   time = scene.time;
   time.substeps = stages[0].substeps;
   job.sys = make_system(scene, time.h());
-  if (!resuming) prepare_run_dir(dir, scene);
+  // The new run is written beside the old one and swapped in at the end (locked meanwhile), so a failed or
+  // killed job leaves an existing run directory as it was.
+  StagedDir staged(dir);
+  const fs::path work = staged.path();
+  if (resuming) staged.copy_from_target([](const std::string&) { return true; });
+  else naming_run_dir(staged, [&] { prepare_run_dir(work, scene); });
 
   EvaluationLog elog(opt.quiet);
   if (!plan.why.empty() && !resuming) elog.say(plan.why);
@@ -376,7 +411,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     if (spec.first_step < 0) spec.first_step = plan.scaled_first_step ? problem.control_scale() : 0;
     Progress progress("optimize " + scene.name, spec.max_evaluations);
     const OptimizeResult res = run_stage(problem, spec, scene.optimizer.restarts, z, stage_id, time.substeps,
-                                         job.seconds, elog, progress);
+                                         job.seconds, elog, progress, job.tape);
     progress.finish();
     z = res.z;
     StageResult st;
@@ -393,7 +428,8 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     job.interrupted = res.interrupted;
   }
 
-  const nlohmann::json report = write_run_report(dir, scene, stages.size(), resuming, job, elog);
+  nlohmann::json report;
+  naming_run_dir(staged, [&] { report = write_run_report(work, scene, stages.size(), resuming, job, elog); });
   std::ostringstream tail;
   tail << job.status << " after " << job.evaluations << " evaluations in " << std::fixed << std::setprecision(2)
        << job.seconds << " s; objective " << std::scientific << report["final_objective"].get<double>();
@@ -404,7 +440,9 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   else
     elog.say(job.diagnosis.line);
   if (opt.quiet && !job.interrupted && !job.diagnosis.failed()) std::cout << job.diagnosis.line << std::endl;
-  write_file_atomic(dir / (resuming ? "log_resumed.txt" : "log.txt"), elog.text());
+  commit_run_dir(staged, [&](const fs::path& w) {
+    write_file_atomic(w / (resuming ? "log_resumed.txt" : "log.txt"), elog.text());
+  });
   return {dir, job.interrupted, !job.interrupted && job.diagnosis.failed(), job.diagnosis.line};
 }
 

@@ -5,13 +5,41 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/file_name.h"
+#include "scene/run_name.h"
 
 namespace kf {
 namespace fs = std::filesystem;
 
 fs::path run_dir_for(const Scene& scene, const std::string& out_option) {
+  if (has_control_character(out_option))
+    throw InputError("--out: contains a control character, got \"" + printable(out_option) + "\"");
+  const std::string scene_dir = fs::absolute(scene.directory.empty() ? fs::path(".") : scene.directory).string();
+  if (has_control_character(scene_dir))
+    throw InputError(scene.file.string() + ": the scene's directory contains a control character, got \"" +
+                     printable(scene_dir) + "\"");
   if (!out_option.empty()) return fs::path(out_option);
+  if (const std::string why = file_name_problem(scene.name); !why.empty())
+    throw InputError(scene.file.string() + ": the file's name " + why + ", so it cannot name the run directory " +
+                     "(got \"" + printable(scene.name) + "\"); rename the file or pass --out");
   return fs::path("out") / scene.name;
+}
+
+void naming_run_dir(const StagedDir& staged, const std::function<void()>& step) {
+  try {
+    step();
+  } catch (const OutputError& e) {
+    throw OutputError(staged.public_message(e.what()));
+  } catch (const InputError& e) {
+    throw InputError(staged.public_message(e.what()));
+  }
+}
+
+void commit_run_dir(StagedDir& staged, const std::function<void(const fs::path& dir)>& fill) {
+  naming_run_dir(staged, [&] {
+    fill(staged.path());
+    staged.commit();
+  });
 }
 
 void prepare_run_dir(const fs::path& dir, const Scene& scene) {
@@ -47,10 +75,10 @@ Scene load_run_scene(const fs::path& dir) {
   const fs::path file = dir / "scene.json";
   if (!fs::exists(file)) throw InputError(dir.string() + ": not a run directory (no scene.json)");
   Scene s = load_scene(file);
-  std::ifstream names(dir / "scene_name.txt");
-  std::string name, scene_dir;
-  if (std::getline(names, name) && !name.empty()) s.name = name;
-  if (std::getline(names, scene_dir) && !scene_dir.empty()) s.directory = scene_dir;
+  if (const auto names = read_run_name(dir)) {
+    s.name = names->name;
+    if (!names->directory.empty()) s.directory = names->directory;
+  }
   return s;
 }
 

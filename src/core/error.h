@@ -13,7 +13,7 @@ enum ExitCode : int {
   kExitInput = 3,        // bad scene file, asset or run directory
   kExitOutput = 4,       // an output could not be written
   kExitNotReady = 5,     // a subcommand that is not available yet
-  kExitInterrupted = 6,  // stopped by SIGINT/SIGTERM after saving what it had
+  kExitInterrupted = 6,  // stopped by SIGINT, SIGTERM, SIGHUP or SIGQUIT after saving what it had
   kExitInternal = 10,    // a bug: an unexpected exception
 };
 

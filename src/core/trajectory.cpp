@@ -57,6 +57,10 @@ Trajectory load_trajectory(const std::filesystem::path& path) {
     in.read(reinterpret_cast<char*>(t.v[k].data()), std::streamsize(8 * 3 * p));
   }
   if (!in) throw InputError(path.string() + ": truncated");
+  for (uint32_t k = 0; k < f; ++k)
+    if (!t.x[k].allFinite() || !t.v[k].allFinite())
+      throw InputError(path.string() + ": frame " + std::to_string(k) + " holds a non-finite " +
+                       (t.x[k].allFinite() ? "velocity" : "position") + " (NaN or infinity)");
   return t;
 }
 

@@ -39,6 +39,7 @@ void add_submission_options(CLI::App* sub, Submission& s) {
 
 fs::path keyframe_program(const Submission& s) {
   if (!s.keyframe.empty()) {
+    slurm::check_script_text("--keyframe", s.keyframe);
     // On a shared filesystem the program the nodes run is visible here too (a dry run may name any path).
     if (!s.dry_run && access(s.keyframe.c_str(), X_OK) != 0)
       throw InputError("--keyframe " + s.keyframe + ": not an executable program");
@@ -47,6 +48,7 @@ fs::path keyframe_program(const Submission& s) {
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
   if (ec) throw InputError("cannot tell where keyframe itself is (" + ec.message() + "); pass --keyframe PATH");
+  slurm::check_script_text("keyframe's own path", self.string());
   return self;
 }
 
@@ -102,6 +104,7 @@ void add_farm_render(CLI::App* farm) {
     farm::RenderFarm f;
     f.request = *req;
     f.request.run_dir = fs::absolute(req->run_dir).lexically_normal();
+    slurm::check_script_text("RUN_DIR", f.request.run_dir.string());  // before anything reads or writes it
     if (!size->empty()) parse_size(*size, f.request.width, f.request.height);
     if (!frames->empty()) parse_frames(*frames, f.request.frame_begin, f.request.frame_end);
     f.chunk = *chunk;
@@ -154,6 +157,8 @@ void add_farm_optimize(CLI::App* farm) {
     f.runs = farm::plan_sweep(files, parsed);
     f.out = fs::absolute(out->empty() ? fs::path("out") / ("sweep-" + f.runs.front().scene) : fs::path(*out))
                 .lexically_normal();
+    slurm::check_script_text(out->empty() ? "SCENE (its name names the sweep directory; or pass --out)" : "--out",
+                             f.out.string());
     f.max_evaluations = *max_evaluations;
     f.slurm = opt->slurm;
     f.keyframe = keyframe_program(*opt);

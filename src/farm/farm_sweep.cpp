@@ -9,8 +9,10 @@
 
 #include "report/plot.h"
 #include "app/run_dir.h"
+#include "farm/run_report.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/file_name.h"
 #include "scene/scene.h"
 
 namespace kf::farm {
@@ -53,7 +55,7 @@ std::string cell(const json& j) {
 
 Sweep parse_sweep(const std::string& text) {
   const auto bad = [&](const std::string& why) {
-    return InputError("--sweep " + text + ": " + why +
+    return InputError("--sweep " + printable(text) + ": " + why +
                       " (expected KEY=V1,V2,... with KEY a JSON pointer into the scene, "
                       "e.g. /cloth/stretch=500,2000)");
   };
@@ -66,6 +68,7 @@ Sweep parse_sweep(const std::string& text) {
   } catch (const json::exception&) {
     throw bad("\"" + s.key + "\" is not a JSON pointer");
   }
+  if (has_control_character(text)) throw bad("contains a control character");
   // Split the values at top-level commas.
   const std::string list = text.substr(eq + 1);
   int depth = 0;
@@ -76,7 +79,9 @@ Sweep parse_sweep(const std::string& text) {
     const char c = i < list.size() ? list[i] : ',';
     if (c == '"' && (i == 0 || list[i - 1] != '\\')) quoted = !quoted;
     if (!quoted && (c == '[' || c == '{')) ++depth;
-    if (!quoted && (c == ']' || c == '}')) --depth;
+    if (!quoted && (c == ']' || c == '}') && --depth < 0) throw bad("a ] or } without its opening bracket");
+    if (i == list.size() && quoted) throw bad("an unclosed quote");
+    if (i == list.size() && depth > 0) throw bad("an unclosed [ or {");
     if (c == ',' && depth == 0 && !quoted) {
       if (current.empty()) throw bad("an empty value");
       words.push_back(current);
@@ -160,10 +165,8 @@ std::vector<SweepRun> plan_sweep(const std::vector<fs::path>& scenes, const std:
 }
 
 bool run_finished(const fs::path& run_dir) {
-  std::error_code ec;
-  if (!fs::is_regular_file(run_dir / "report.json", ec)) return false;
-  const json r = json::parse(read_all(run_dir / "report.json"), nullptr, false);
-  return r.is_object() && r.contains("final_objective") && !r.value("interrupted", true);
+  const auto report = read_run_report(run_dir);
+  return report && !report->interrupted;
 }
 
 json sweep_manifest(const SweepFarm& farm) {
@@ -219,32 +222,27 @@ SweepPlan plan_sweep_farm(const SweepFarm& farm) {
 }
 
 std::vector<std::string> gather_sweep(const fs::path& out) {
-  const fs::path manifest_file = out / "sweep.json";
-  std::error_code ec;
-  if (!fs::is_regular_file(manifest_file, ec))
-    throw InputError(out.string() + ": not a sweep directory (no sweep.json; made by keyframe farm optimize)");
-  const json m = json::parse(read_all(manifest_file), nullptr, false);
-  if (!m.is_object() || !m.contains("runs") || !m["runs"].is_array() || !m.contains("keys"))
-    throw InputError(manifest_file.string() + ": not a sweep manifest");
-  const auto keys = m["keys"].get<std::vector<std::string>>();
+  const SweepManifest m = read_sweep_manifest(out);
+  const auto& keys = m.keys;
 
   // Scalar numbers of each report's measures and final terms become columns, in the order first met.
+  // Every report is read (and validated) before anything is written.
   const char* fixed[] = {"evaluations", "wall_seconds", "initial_objective", "final_objective"};
   std::vector<std::string> extra;
   std::set<std::string> seen;
   std::vector<json> reports;
   std::vector<std::string> unfinished;
-  for (const auto& run : m["runs"]) {
-    const fs::path dir = out / run.value("name", "");
+  for (const auto& run : m.runs) {
     json flat;
-    if (run_finished(dir)) {
-      flat = json::parse(read_all(dir / "report.json")).flatten();
+    const auto report = read_run_report(out / run.name);
+    if (report && !report->interrupted) {
+      flat = report->json.flatten();
       for (const auto& [k, v] : flat.items())
         if (v.is_number() && (k.rfind("/measures/", 0) == 0 || k.rfind("/final_terms/", 0) == 0) &&
             seen.insert(k).second)
           extra.push_back(k);
     } else {
-      unfinished.push_back(run.value("name", ""));
+      unfinished.push_back(run.name);
     }
     reports.push_back(flat);
   }
@@ -255,10 +253,10 @@ std::vector<std::string> gather_sweep(const fs::path& out) {
   for (const auto& k : extra) csv << "," << plain(k.substr(1), "/._-");
   csv << ",status\n";
   for (size_t i = 0; i < reports.size(); ++i) {
-    const json& run = m["runs"][i];
+    const auto& run = m.runs[i];
     const json& r = reports[i];
-    csv << cell(run.value("name", "")) << "," << cell(run.value("scene", ""));
-    for (const auto& k : keys) csv << "," << (run["values"].contains(k) ? cell(run["values"][k]) : "");
+    csv << cell(run.name) << "," << cell(run.scene);
+    for (const auto& k : keys) csv << "," << cell(run.values[k]);
     for (const char* f : fixed) csv << "," << (r.contains(std::string("/") + f) ? cell(r[std::string("/") + f]) : "");
     for (const auto& k : extra) csv << "," << (r.contains(k) ? cell(r[k]) : "");
     csv << "," << (r.is_null() ? "not finished" : cell(r.value("/status", json("finished")))) << "\n";
@@ -269,9 +267,9 @@ std::vector<std::string> gather_sweep(const fs::path& out) {
   const int final_col = 2 + int(keys.size()) + 4;
   bool numeric = keys.size() == 1;
   std::set<std::string> scenes;
-  for (const auto& run : m["runs"]) {
-    scenes.insert(run.value("scene", ""));
-    if (numeric && !(run["values"].contains(keys[0]) && run["values"][keys[0]].is_number())) numeric = false;
+  for (const auto& run : m.runs) {
+    scenes.insert(run.scene);
+    if (numeric && !run.values[keys[0]].is_number()) numeric = false;
   }
   const std::string title = out.filename().string() + ": final objective";
   if (numeric && scenes.size() == 1)

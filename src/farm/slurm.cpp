@@ -9,6 +9,7 @@
 #include <regex>
 
 #include "core/error.h"
+#include "core/file_name.h"
 #include "render/clip/make_clip.h"
 
 extern char** environ;
@@ -64,9 +65,17 @@ void check(const JobOptions& o) {
   for (const auto& [name, value] : named)
     if (value->find_first_of("\n\r") != std::string::npos)
       throw InputError(std::string(name) + ": expected one line, got a line break");
+    else
+      check_script_text(name, *value);
   for (const auto& e : o.extra)
-    if (e.size() < 2 || e[0] != '-' || e.find_first_of("\n\r") != std::string::npos)
-      throw InputError("--sbatch: expected one sbatch option such as --qos=high, got \"" + one_line(e) + "\"");
+    if (e.size() < 2 || e[0] != '-' || has_control_character(e))
+      throw InputError("--sbatch: expected one sbatch option such as --qos=high, got \"" + printable(e) + "\"");
+}
+
+void check_script_text(const std::string& option, const std::string& value) {
+  if (has_control_character(value))
+    throw InputError(option + ": contains a control character, got \"" + printable(value) +
+                     "\" (a job script cannot hold it)");
 }
 
 std::string sbatch_lines(const JobOptions& o) {

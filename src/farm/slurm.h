@@ -12,8 +12,14 @@ struct JobOptions {
   std::vector<std::string> extra;  // further sbatch options, verbatim ("--qos=high", "--gres=gpu:1")
 };
 
-// Throws InputError for an option that cannot be an #SBATCH line (not starting with '-', a line break).
+// Throws InputError for an option that cannot be an #SBATCH line (not starting with '-', a line break or
+// another control character).
 void check(const JobOptions& options);
+
+// Throws InputError "OPTION: contains a control character, got \"...\" (a job script cannot hold it)" when
+// `value` (a path or name written into a job script) holds a newline or another control character: a
+// newline would end the comment or #SBATCH line it is on and start a command of its own.
+void check_script_text(const std::string& option, const std::string& value);
 
 // One "#SBATCH --option=value\n" line per option given, in a fixed order, the extras last.
 std::string sbatch_lines(const JobOptions& options);

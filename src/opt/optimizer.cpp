@@ -13,10 +13,13 @@ struct Driver {
   Problem& problem;
   const std::function<void(const EvaluationRecord&)>& on_eval;
   const std::atomic<bool>* stop;
+  EvaluationTape* tape;
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
   OptimizeResult result;
   VecX z, g;
 
+  int max_evaluations = 0;  // a hard limit (NLopt's own maxeval may run past it); 0: none
+  bool limit_reached = false;
   // NLopt's variables y give the controls z = z0 + scale·y (scale 1: z = y, bit for bit as without it).
   VecX z0;
   double scale = 1;
@@ -47,15 +50,33 @@ struct Driver {
       result.interrupted = true;
       throw nlopt::forced_stop();
     }
+    if (max_evaluations > 0 && result.evaluations >= max_evaluations) {
+      limit_reached = true;
+      throw nlopt::forced_stop();
+    }
     g.resize(z.size());
-    const double phi = problem.evaluate(z, gz);
     EvaluationRecord rec;
+    const RecordedEvaluation* replayed = tape && gz ? tape->replay(z) : nullptr;
+    double phi;
+    if (replayed) {
+      phi = replayed->phi;
+      *gz = replayed->g;
+      rec.diverged = replayed->diverged;
+      rec.terms = replayed->terms;
+      rec.seconds = replayed->seconds;
+      // Later evaluations count their seconds on from the recorded ones.
+      start = std::chrono::steady_clock::now() - std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                     std::chrono::duration<double>(replayed->seconds));
+    } else {
+      phi = problem.evaluate(z, gz);
+      rec.diverged = problem.last_diverged();
+      rec.terms = problem.breakdown();
+      rec.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+    if (tape && gz) tape->record({z, *gz, phi, rec.seconds, rec.diverged, rec.terms});
     rec.evaluation = ++result.evaluations;
     rec.phi = phi;
     rec.grad_norm = gz ? gz->norm() : 0;
-    rec.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    rec.diverged = problem.last_diverged();
-    rec.terms = problem.breakdown();
     if (!rec.diverged && phi < result.phi) {
       result.phi = phi;
       result.z = z;
@@ -86,8 +107,8 @@ std::string status_name(nlopt::result r) {
 
 OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX& z0,
                         const std::function<void(const EvaluationRecord&)>& on_eval,
-                        const std::atomic<bool>* stop) {
-  Driver d{problem, on_eval, stop};
+                        const std::atomic<bool>* stop, EvaluationTape* tape) {
+  Driver d{problem, on_eval, stop, tape};
   d.result.phi = std::numeric_limits<double>::infinity();
   d.result.z = z0;
   const unsigned n = unsigned(z0.size());
@@ -109,7 +130,7 @@ OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX&
         d.z = z0;
         d.first_phi = d.evaluate(&d.g);
         d.first_g = d.g;
-        d.have_first = !d.problem.last_diverged();
+        d.have_first = !d.result.history.back().diverged;  // a replayed evaluation leaves the problem untouched
         d.z0 = z0;
         const double gnorm = d.first_g.norm(), step = rms * std::sqrt(double(n));
         if (d.have_first && std::isfinite(gnorm) && gnorm > step) {
@@ -120,6 +141,7 @@ OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX&
       nlopt::opt opt(nlopt::LD_LBFGS, n);
       opt.set_min_objective(&Driver::thunk, &d);
       opt.set_maxeval(spec.max_evaluations);
+      d.max_evaluations = spec.max_evaluations;
       if (spec.ftol_rel > 0) opt.set_ftol_rel(spec.ftol_rel);
       if (spec.max_seconds > 0) opt.set_maxtime(spec.max_seconds);
       opt.set_vector_storage(unsigned(spec.memory));
@@ -132,6 +154,9 @@ OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX&
       // LBFGS gives up this way when the line search cannot make progress; the best point stands.
       d.result.status = std::string("stopped: line search made no progress (") + e.what() + ")";
     }
+    // NLopt may report a forced stop as a generic failure; what stopped it is known here.
+    if (d.result.interrupted) d.result.status = "interrupted";
+    else if (d.limit_reached) d.result.status = status_name(nlopt::MAXEVAL_REACHED);
   }
   d.result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d.start).count();
   if (!std::isfinite(d.result.phi)) d.result.phi = problem.evaluate(d.result.z, nullptr);

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "opt/evaluation_tape.h"
 #include "opt/problem.h"
 #include "scene/objective_spec.h"
 
@@ -29,10 +30,12 @@ struct OptimizeResult {
   std::vector<EvaluationRecord> history;
 };
 
-// Minimises φ from z0. `on_eval` sees each evaluation as it happens; setting *stop makes the next
-// evaluation end the optimisation with the best point so far (used for SIGINT/SIGTERM).
+// Minimises φ from z0 within spec.max_evaluations (a hard limit). `on_eval` sees each evaluation as it
+// happens; setting *stop makes the next evaluation end the optimisation with the best point so far (used for
+// SIGINT/SIGTERM). With a `tape`, every evaluation is recorded on it, and evaluations it replays (an
+// interrupted run resumed) are taken from it instead of computed.
 OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX& z0,
                         const std::function<void(const EvaluationRecord&)>& on_eval = {},
-                        const std::atomic<bool>* stop = nullptr);
+                        const std::atomic<bool>* stop = nullptr, EvaluationTape* tape = nullptr);
 
 }  // namespace kf

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 
 #include "core/error.h"
+#include "core/json_depth.h"
 #include "core/trajectory.h"
 #include "scene/params.h"
 #include "scene/scene.h"
@@ -96,7 +98,9 @@ CapeAnchors load_cape_anchors(const std::filesystem::path& file) {
   if (!in) throw InputError(file.string() + ": cannot open the cape anchors file");
   Json j;
   try {
-    j = Json::parse(in);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    check_json_depth(text, file.string());
+    j = Json::parse(text);
   } catch (const Json::exception& e) {
     throw InputError(file.string() + ": not valid JSON (" + e.what() + ")");
   }
@@ -109,6 +113,9 @@ CharacterSpec parse_character_spec(Block b, Scene& scene) {
   CharacterSpec c;
   const int p = scene.particles();
   c.file = scene.directory / b.string("file");
+  // A missing mesh is named here, before the anchors that would be looked for beside it.
+  if (std::error_code ec; !std::filesystem::is_regular_file(c.file, ec))
+    b.fail("file", "no such mesh file " + c.file.string());
   c.animation = b.integer("animation", 0, 0, 1000);
   if (b.has("time")) {
     c.time_keys = b.points2("time", 1, -1e6, 1e6);

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/json_depth.h"
 #include "scene/params.h"
 
 namespace kf {
@@ -156,6 +157,7 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls) {
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::filesystem::path& file) {
+  check_json_depth(text, file.string());
   Json j;
   try {
     j = Json::parse(text);

@@ -270,8 +270,109 @@ INSTANTIATE_TEST_SUITE_P(
         BadFarm{"SweepEmptyValue", "optimize scene.json --sweep /controls/alpha=1,,2", kExitInput,
                 "--sweep /controls/alpha=1,,2: an empty value (expected KEY=V1,V2,... with KEY a JSON pointer into "
                 "the scene, e.g. /cloth/stretch=500,2000)"},
-        BadFarm{"SceneMissing", "optimize nosuch.json", kExitInput, "nosuch.json: cannot open scene file"}),
+        BadFarm{"SceneMissing", "optimize nosuch.json", kExitInput, "nosuch.json: cannot open scene file"},
+        // Sweep values that do not parse: refused with the reason, never a crash.
+        BadFarm{"SweepUnclosedBracket", "optimize scene.json --sweep '/flock/spawn/center=[1,0,3'", kExitInput,
+                "--sweep /flock/spawn/center=[1,0,3: an unclosed [ or { (expected KEY=V1,V2,... with KEY a JSON "
+                "pointer into the scene, e.g. /cloth/stretch=500,2000)"},
+        BadFarm{"SweepUnclosedQuote", "optimize scene.json --sweep '/controls/kind=\"abc'", kExitInput,
+                "--sweep /controls/kind=\"abc: an unclosed quote (expected KEY=V1,V2,... with KEY a JSON pointer "
+                "into the scene, e.g. /cloth/stretch=500,2000)"},
+        BadFarm{"SweepOpenBrace", "optimize scene.json --sweep '/controls/alpha={'", kExitInput,
+                "--sweep /controls/alpha={: an unclosed [ or { (expected KEY=V1,V2,... with KEY a JSON pointer into "
+                "the scene, e.g. /cloth/stretch=500,2000)"},
+        BadFarm{"SweepStrayBracket", "optimize scene.json --sweep '/controls/alpha=]1,2'", kExitInput,
+                "--sweep /controls/alpha=]1,2: a ] or } without its opening bracket (expected KEY=V1,V2,... with KEY a "
+                "JSON pointer into the scene, e.g. /cloth/stretch=500,2000)"},
+        BadFarm{"SweepValueWithNewline", "optimize scene.json --sweep \"$(printf '/controls/alpha=1\\n2')\"",
+                kExitInput,
+                "--sweep /controls/alpha=1\\n2: contains a control character (expected KEY=V1,V2,... with KEY a JSON "
+                "pointer into the scene, e.g. /cloth/stretch=500,2000)"},
+        BadFarm{"OutWithNewline", "optimize scene.json --sweep /controls/alpha=1,2 --dry-run "
+                "--out \"$(printf 'nl\\ntouch PWNED\\n#')\"", kExitInput,
+                "--out: contains a control character, got \"$DIR/nl\\ntouch PWNED\\n#\" (a job script cannot hold it)"},
+        BadFarm{"KeyframeProgramWithNewline", "render run --dry-run --keyframe \"$(printf '/bin/k\\nrm -rf x')\"",
+                kExitInput, "--keyframe: contains a control character, got \"/bin/k\\nrm -rf x\" (a job script cannot "
+                "hold it)"},
+        BadFarm{"SbatchOptionWithTab", "render run --sbatch=\"$(printf -- '--qos=a\\tb')\"", kExitInput,
+                "--sbatch: expected one sbatch option such as --qos=high, got \"--qos=a\\tb\""}),
     [](const ::testing::TestParamInfo<BadFarm>& info) { return std::string(info.param.name); });
+
+// A newline in a path that reaches a job script would end the `#` comment or `#SBATCH` line it is on and
+// start a command of its own: such paths are refused before anything is written or submitted.
+TEST_F(Farm, RunDirectoryWithANewlineIsRefusedNotWrittenIntoAScript) {
+  const std::string evil = "nl\ntouch PWNED\n#";
+  fs::copy(dir_ / "run", dir_ / evil, fs::copy_options::recursive);
+  const auto before = list_tree(dir_);
+  for (const char* extra : {" --dry-run", ""}) {
+    const CliResult r = farm(std::string("render \"$(printf 'nl\\ntouch PWNED\\n#')\"") + extra);
+    EXPECT_EQ(r.code, kExitInput) << r.output;
+    EXPECT_EQ(r.output, "keyframe: error: RUN_DIR: contains a control character, got \"" + dir_.string() +
+                            "/nl\\ntouch PWNED\\n#\" (a job script cannot hold it)\n");
+  }
+  EXPECT_TRUE(sbatch_calls().empty());
+  EXPECT_EQ(list_tree(dir_), before);
+  EXPECT_FALSE(fs::exists(dir_ / "PWNED"));
+}
+
+TEST_F(Farm, SceneFileNameWithANewlineIsRefused) {
+  // The scene's name sets the default --out, which the scripts name.
+  write("nl\ntouch PWNED\n#.json", small_flock_scene(11));
+  const auto before = list_tree(dir_);
+  const CliResult r = farm("optimize \"$(printf 'nl\\ntouch PWNED\\n#.json')\" --sweep /controls/alpha=1,2");
+  EXPECT_EQ(r.code, kExitInput) << r.output;
+  EXPECT_EQ(count_lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("contains a control character"), std::string::npos) << r.output;
+  EXPECT_TRUE(sbatch_calls().empty());
+  EXPECT_EQ(list_tree(dir_), before);
+}
+
+// What gather reads back is validated like a scene: wrong types are exit 3 naming the file and the key.
+class FarmGather : public Farm {
+ protected:
+  void SetUp() override {
+    Farm::SetUp();
+    ASSERT_EQ(farm("optimize scene.json --sweep /controls/alpha=0.01,0.1 --out sweep").code, 0);
+    for (int task = 0; task < 2; ++task) ASSERT_EQ(run_script(dir_ / "sweep/farm/optimize.sbatch", task).code, 0);
+    ASSERT_EQ(run_keyframe("farm gather sweep", dir_).code, 0);
+  }
+  void expect_gather_refused(const std::string& message) {
+    const std::string csv = read_text(dir_ / "sweep/sweep.csv");
+    const CliResult r = run_keyframe("farm gather sweep", dir_);
+    EXPECT_EQ(r.code, kExitInput) << r.output;
+    EXPECT_EQ(r.output, "keyframe: error: " + message + "\n");
+    EXPECT_EQ(read_text(dir_ / "sweep/sweep.csv"), csv) << "gather rewrote sweep.csv from bad input";
+  }
+  // Replaces `from` by `to` in FILE (relative to the sweep directory).
+  void edit(const std::string& file, const std::string& from, const std::string& to) {
+    std::string text = read_text(dir_ / "sweep" / file);
+    const size_t at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from << " not in " << file;
+    write_text(dir_ / "sweep" / file, text.replace(at, from.size(), to));
+  }
+};
+
+TEST_F(FarmGather, ReportWithAStringObjectiveIsRefused) {
+  edit("scene_alpha=0.1/report.json", "\"final_objective\": ", "\"final_objective\": \"abc\", \"was\": ");
+  expect_gather_refused("sweep/scene_alpha=0.1/report.json: /final_objective: expected a finite number, got "
+                        "string \"abc\"");
+}
+
+TEST_F(FarmGather, ReportWithAStringInterruptedIsRefused) {
+  edit("scene_alpha=0.01/report.json", "\"interrupted\": false", "\"interrupted\": \"no\"");
+  expect_gather_refused("sweep/scene_alpha=0.01/report.json: /interrupted: expected true or false, got string \"no\"");
+}
+
+TEST_F(FarmGather, ManifestWithOddKeysIsRefused) {
+  edit("sweep.json", "\"keys\": [", "\"keys\": [7, ");
+  expect_gather_refused("sweep/sweep.json: /keys/0: expected a JSON pointer such as \"/cloth/stretch\", got number 7");
+}
+
+TEST_F(FarmGather, ManifestRunNameThatLeavesTheSweepIsRefused) {
+  edit("sweep.json", "\"name\": \"scene_alpha=0.01\"", "\"name\": \"../../elsewhere\"");
+  expect_gather_refused("sweep/sweep.json: /runs/0/name: the run's directory name contains '/', got "
+                        "\"../../elsewhere\"");
+}
 
 }  // namespace
 }  // namespace kf::reliability

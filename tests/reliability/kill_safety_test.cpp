@@ -13,6 +13,7 @@
 #include "cli_harness.h"
 #include "core/error.h"
 #include "core/trajectory.h"
+#include "opt/evaluation_tape.h"
 #include "render/image/png_io.h"
 
 namespace kf::reliability {
@@ -55,6 +56,8 @@ void expect_file_valid(const fs::path& file) {
     uint64_t n = 0;
     std::memcpy(&n, b.data() + 8, 8);
     EXPECT_EQ(b.size(), 20 + 8 * n);  // header: magic, count, substeps (opt/controls_file.h)
+  } else if (name == "evaluations.bin") {
+    EXPECT_NO_THROW({ auto e = load_evaluations(file); (void)e; });
   } else if (ext == ".png") {
     EXPECT_NO_THROW({ auto img = render::read_png(file); (void)img; });
   } else if (ext == ".csv") {
@@ -79,7 +82,8 @@ void expect_file_valid(const fs::path& file) {
 std::set<std::string> expect_run_dir_valid(const fs::path& run, const std::string& when) {
   static const std::set<std::string> kKnown = {"scene.json",     "scene_name.txt", "controls.bin",
                                                "trajectory.bin", "iterations.csv", "convergence.png",
-                                               "report.json",    "log.txt",        "frames"};
+                                               "report.json",    "log.txt",        "frames",
+                                               "evaluations.bin"};
   std::set<std::string> seen;
   if (!fs::exists(run)) return seen;
   for (const auto& e : fs::recursive_directory_iterator(run)) {

@@ -80,6 +80,30 @@ bool ffmpeg_or_skip() {
   return false;
 }
 
+TEST(Clip, TruncatedFrameIsRefusedBeforeEncoding) {
+  // ffmpeg skips a frame it cannot decode and exits 0; the clip must not be made from a broken frame.
+  testing::TempDir tmp;
+  const auto run = testing::make_flock_run(tmp.path() / "flock");
+  RenderRequest rr;
+  rr.run_dir = run;
+  rr.width = 64;
+  rr.height = 48;
+  ASSERT_EQ(render_run(rr), 6);
+  const fs::path frame = run / "frames/frame_0003.png";
+  fs::resize_file(frame, fs::file_size(frame) / 2);
+  ClipRequest r;
+  r.run_dir = run;
+  r.ffmpeg = "/bin/true";  // never reached
+  try {
+    make_clip(r);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(frame.string() + ": corrupt or truncated PNG", 0), 0u) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(run / "clip.mp4"));
+  EXPECT_FALSE(fs::exists(run / "clip.mp4.partial"));
+}
+
 TEST(Clip, EncodesFramesAndATurntableAsMp4AndGif) {
   if (!ffmpeg_or_skip()) GTEST_SKIP() << "ffmpeg not installed";
   testing::TempDir tmp;

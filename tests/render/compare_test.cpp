@@ -12,6 +12,7 @@
 #include "render/image/diff_heatmap.h"
 #include "render/image/image_metrics.h"
 #include "render/render_run.h"
+#include "png_files.h"
 #include "synthetic_runs.h"
 
 namespace kf::render {
@@ -228,6 +229,71 @@ TEST(Compare, BadInputIsOneClearError) {
   r.actual = a;
   r.reference = ref;
   EXPECT_EQ(compare_frames(r).failed, 0);
+}
+
+TEST(Compare, InterlacedFramesWithTheSamePixelsPass) {
+  testing::TempDir tmp;
+  const fs::path ref = tmp.path() / "ref", actual = tmp.path() / "actual";
+  fs::create_directories(ref);
+  fs::create_directories(actual);
+  Image img(40, 30, 3);
+  for (size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = uint8_t((i * 37) % 251);
+  write_png(ref / "frame_0000.png", img);
+  write_interlaced_png(actual / "frame_0000.png", img);
+  CompareRequest r;
+  r.actual = actual;
+  r.reference = ref;
+  const CompareResult res = compare_frames(r);
+  EXPECT_EQ(res.failed, 0);
+  EXPECT_EQ(res.frames.at(0).metrics.max_abs, 0);
+
+  // A truncated interlaced frame is refused, and --update does not copy it into the references.
+  const std::string bytes = slurp(actual / "frame_0000.png");
+  std::ofstream(actual / "frame_0000.png", std::ios::binary | std::ios::trunc) << bytes.substr(0, bytes.size() - 40);
+  const std::string before = slurp(ref / "frame_0000.png");
+  r.update = true;
+  EXPECT_THROW(compare_frames(r), InputError);
+  EXPECT_EQ(slurp(ref / "frame_0000.png"), before);
+}
+
+TEST(Compare, AlphaDifferenceFailsTheFrame) {
+  testing::TempDir tmp;
+  const fs::path ref = tmp.path() / "ref", actual = tmp.path() / "actual";
+  fs::create_directories(ref);
+  fs::create_directories(actual);
+  Image opaque(20, 10, 3), transparent(20, 10, 4);  // same colour, one fully transparent
+  write_png(ref / "frame_0000.png", opaque);
+  write_png(actual / "frame_0000.png", transparent);
+  CompareRequest r;
+  r.actual = actual;
+  r.reference = ref;
+  r.thresholds = noise_thresholds();
+  const CompareResult res = compare_frames(r);
+  EXPECT_EQ(res.failed, 1);
+  EXPECT_EQ(res.frames.at(0).metrics.max_abs, 255);
+  EXPECT_EQ(res.frames.at(0).why, "100% of pixels differ by more than 48 levels (allowed 1%, largest difference 255)");
+  // Opaque alpha against no alpha is the same frame.
+  for (size_t i = 3; i < transparent.pixels.size(); i += 4) transparent.pixels[i] = 255;
+  write_png(actual / "frame_0000.png", transparent);
+  r.thresholds = {};
+  EXPECT_EQ(compare_frames(r).failed, 0);
+}
+
+TEST(Compare, SizeMismatchIsFoundFromTheHeaders) {
+  // The actual frame claims 8000x10 pixels but holds none: the mismatch is reported without decoding it,
+  // and a header past the size limit is refused before any pixel is allocated.
+  testing::TempDir tmp;
+  const fs::path ref = tmp.path() / "ref", actual = tmp.path() / "actual";
+  fs::create_directories(ref);
+  fs::create_directories(actual);
+  write_png(ref / "frame_0000.png", Image(64, 48, 3));
+  write_header_only_png(actual / "frame_0000.png", 8000, 10);
+  std::string e = input_error(actual, ref);
+  EXPECT_EQ(e, (actual / "frame_0000.png").string() + ": 8000x10 pixels, but the reference " +
+                   (ref / "frame_0000.png").string() + " has 64x48");
+  write_header_only_png(actual / "frame_0000.png", 20000, 20000);
+  e = input_error(actual, ref);
+  EXPECT_NE(e.find("20000x20000 pixels, larger than keyframe reads"), std::string::npos) << e;
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
 #include "core/error.h"
 #include "scene/scene.h"
@@ -61,6 +62,8 @@ TEST(CapeAnchors, UnknownMeshIsAnInputError) {
 TEST(CapeAnchors, ReadFromTheSceneOrTheFileBesideTheMesh) {
   test::TempDir tmp;
   std::filesystem::copy_file(cape_anchors_file(test::character_asset()), tmp.path() / "body.cape.json");
+  // The meshes exist (a missing mesh is refused on /character/file first); parsing never opens them.
+  for (const char* mesh : {"body.X", "other.X"}) std::ofstream(tmp.path() / mesh) << "xof 0303txt 0032\n";
   const auto scene_with = [&](const std::string& character) {
     return R"({"time": {"fps": 30, "frames": 2}, "cloth": {"nx": 4, "ny": 4}, "character": )" + character + "}";
   };
@@ -93,6 +96,8 @@ TEST(CapeAnchors, ReadFromTheSceneOrTheFileBesideTheMesh) {
 TEST(CharacterRootMotion, InterpolatesKeysAndMovesThePosedBodyRigidly) {
   test::TempDir tmp;
   std::filesystem::copy_file(cape_anchors_file(test::character_asset()), tmp.path() / "body.cape.json");
+  // The meshes exist (a missing mesh is refused on /character/file first); parsing never opens them.
+  for (const char* mesh : {"body.X", "other.X"}) std::ofstream(tmp.path() / mesh) << "xof 0303txt 0032\n";
   const Scene scene = parse_scene(R"({"time": {"fps": 30, "frames": 2}, "cloth": {"nx": 4, "ny": 4},
     "character": {"file": "body.X", "offset": [0, 1, 0],
       "root": {"pivot": [0, -1, 0], "axis": [2, 0, 0],
