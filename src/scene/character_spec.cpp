@@ -148,6 +148,8 @@ CharacterSpec parse_character_spec(Block b, Scene& scene) {
     c.body_thickness = body.number("thickness", c.body_thickness, 1e-5, 1.0);
     c.body_stiffness = body.number("stiffness", c.body_stiffness, 0.0, 1e8);
     c.body_search = body.number("search", c.body_search, 0.0, 1.0);
+    c.body_friction = body.number("friction", c.body_friction, 0.0, 10.0);
+    c.body_friction_velocity = body.number("friction_velocity", c.body_friction_velocity, 1e-6, 100.0);
     body.finish();
   }
   {
@@ -155,6 +157,8 @@ CharacterSpec parse_character_spec(Block b, Scene& scene) {
     c.self_collision = self.boolean("enabled", c.self_collision);
     c.self_thickness = self.number("thickness", c.self_thickness, 1e-5, 1.0);
     c.self_stiffness = self.number("stiffness", c.self_stiffness, 0.0, 1e8);
+    c.self_friction = self.number("friction", c.self_friction, 0.0, 10.0);
+    c.self_friction_velocity = self.number("friction_velocity", c.self_friction_velocity, 1e-6, 100.0);
     self.finish();
   }
   if (auto start = b.optional_child("start")) {

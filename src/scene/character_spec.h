@@ -20,8 +20,9 @@
 //                                      // names: {"nodes": ["L_Shoulder", "Neck", "R_Shoulder"]}
 //                                      // (`keyframe inspect MESH` lists them); default: the file
 //                                      // beside the mesh named like it with ".cape.json"
-//     "body": {"thickness": 0.012, "stiffness": 2000, "search": 0.06},
-//     "self": {"enabled": true, "thickness": 0.01, "stiffness": 500},
+//     "body": {"thickness": 0.012, "stiffness": 2000, "search": 0.06,
+//              "friction": 0, "friction_velocity": 0.01},  // Coulomb coefficient, sticking speed (m/s)
+//     "self": {"enabled": true, "thickness": 0.01, "stiffness": 500, "friction": 0, "friction_velocity": 0.01},
 //     "start": {"run": "../out/cape-a", "frame": 39},             // initial cape state (x and v)
 //     "end_target": {"run": "../out/cape-b", "frame": 51,          // adds "position" and "velocity"
 //                    "position_weight": 1, "velocity_weight": 0.01} // objectives at the last frame
@@ -80,9 +81,13 @@ struct CharacterSpec {
   double body_thickness = 0.012;     // m: contact springs act within this distance of the body
   double body_stiffness = 2000.0;    // N/m
   double body_search = 0.06;         // m: particles deeper than this inside the body get no force
+  double body_friction = 0;          // Coulomb coefficient of the cape on the body (0: frictionless)
+  double body_friction_velocity = 0.01;  // m/s: slip slower than this counts as sticking
   bool self_collision = true;
   double self_thickness = 0.01;      // m: particle pairs closer than this repel
   double self_stiffness = 500.0;     // N/m
+  double self_friction = 0;          // Coulomb coefficient of cloth on cloth (0: frictionless)
+  double self_friction_velocity = 0.01;  // m/s
   // Start state from a run's trajectory (empty x: the cloth block's flat layout).
   std::filesystem::path start_run;
   int start_frame = 0;

@@ -73,6 +73,8 @@ ColliderSpec parse_collider(Block b) {
     if (type == t.name) c.shape = t.parse(b);
   c.thickness = b.number("thickness", c.thickness, 1e-6, 10.0);
   c.stiffness = b.number("stiffness", c.stiffness, 0.0, 1e9);
+  c.friction = b.number("friction", c.friction, 0.0, 10.0);
+  c.friction_velocity = b.number("friction_velocity", c.friction_velocity, 1e-6, 100.0);
   b.finish();
   return c;
 }

@@ -44,11 +44,14 @@ struct CapsuleShape {
 
 using ColliderShape = std::variant<GroundShape, SphereShape, TorusShape, CapsuleShape>;
 
-// A collider the cloth is pushed out of by stiff springs inside `thickness`.
+// A collider the cloth is pushed out of by stiff springs inside `thickness`, with smoothed Coulomb friction
+// (sim/cloth/friction.h) against sliding along it.
 struct ColliderSpec {
   ColliderShape shape;
   double thickness = 0.01;  // contact springs act within this distance of the surface (m)
   double stiffness = 1e4;   // N/m
+  double friction = 0;      // Coulomb coefficient (0, the default: frictionless)
+  double friction_velocity = 0.01;  // m/s: slip slower than this counts as sticking (viscous below it)
 };
 
 // The scene-file name of the collider's shape ("ground", ...).

@@ -112,8 +112,8 @@ const BadScene kBadScenes[] = {
      "s.json: /colour: unknown key (check its spelling; see README 'Scene files')"},
     {"MisspelledFlockKey", "simulate", flock_with(R"({"agnets": 10})"),
      "s.json: /flock/agnets: unknown key (check its spelling; see README 'Scene files')"},
-    {"UnknownColliderKey", "simulate", cloth_with(R"({"colliders": [{"type": "ground", "friction": 1}]})"),
-     "s.json: /cloth/colliders/0/friction: unknown key (check its spelling; see README 'Scene files')"},
+    {"UnknownColliderKey", "simulate", cloth_with(R"({"colliders": [{"type": "ground", "fricton": 1}]})"),
+     "s.json: /cloth/colliders/0/fricton: unknown key (check its spelling; see README 'Scene files')"},
     // Keyframes.
     {"KeyframeAfterEnd", "optimize",
      flock_with("{}", R"(, "objectives": [{"type": "center_of_mass", "frame": 11, "target": [0, 0, 0]}])"),

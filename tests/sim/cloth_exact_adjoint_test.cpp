@@ -73,6 +73,26 @@ const Case kCases[] = {
        "colliders": [{"type": "ground", "center": [0, 0, 0], "axis": [0, 1, 0], "thickness": 0.03, "stiffness": 3000}])",
      R"({"kind": "per_frame", "alpha": 1e-4})",
      R"([{"type": "center_of_mass", "frame": 3, "weight": 100, "target": [0.1, 0.1, 0]}])", 1e-4},
+    // Friction (off in the cases above: colliders are frictionless unless the scene says): a sheet landing
+    // flat and sliding fast along the ground (slip >> friction_velocity), one set down slowly so it sticks
+    // (slip << friction_velocity), a coefficient high enough that the sheet lying on a sphere holds, and the
+    // sphere without friction.
+    {"ground_sliding", R"("origin": [-0.25, 0.012, -0.25], "v_axis": [0, 0, 1], "velocity": [1.5, -0.05, 0.4],
+       "colliders": [{"type": "ground", "thickness": 0.03, "stiffness": 3000, "friction": 0.6}])",
+     R"({"kind": "per_frame", "alpha": 1e-4})",
+     R"([{"type": "center_of_mass", "frame": 3, "weight": 100, "target": [0.2, 0.05, 0.1]}])", 1e-4},
+    {"ground_sticking", R"("origin": [-0.25, 0.012, -0.25], "v_axis": [0, 0, 1], "velocity": [0.002, -0.01, 0.001],
+       "colliders": [{"type": "ground", "thickness": 0.03, "stiffness": 3000, "friction": 0.8, "friction_velocity": 0.05}])",
+     R"({"kind": "per_frame", "alpha": 1e-4})",
+     R"([{"type": "center_of_mass", "frame": 3, "weight": 100, "target": [0.02, 0.05, 0.01]}])", 1e-4},
+    {"sphere_draped_high_friction", R"("origin": [-0.25, 0.12, -0.25], "v_axis": [0, 0, 1], "imperfection": 5e-4,
+       "colliders": [{"type": "sphere", "center": [0, 0, 0], "radius": 0.1, "thickness": 0.03, "stiffness": 3000, "friction": 1.5}])",
+     R"({"kind": "per_frame", "alpha": 1e-4})",
+     R"([{"type": "position", "frame": 3, "weight": 100, "particles": [0], "targets": [[-0.2, 0.0, -0.2]]}])", 1e-4},
+    {"sphere_pinned_frictionless", R"("origin": [-0.25, 0.12, -0.25], "v_axis": [0, 0, 1], "pins": "top_corners",
+       "colliders": [{"type": "sphere", "center": [0, 0, 0], "radius": 0.1, "thickness": 0.03, "stiffness": 3000, "friction": 0}])",
+     R"({"kind": "per_step", "alpha": 1e-4})",
+     R"([{"type": "center_of_mass", "frame": 3, "weight": 100, "target": [0.05, 0.2, 0]}])", 1e-4},
     {"theta_explicit_compressed_arch", R"("origin": [-0.25, 0, -0.25], "v_axis": [0, 0, 1], "gravity": [0, 0, 0],
        "theta": 0.55, "transverse_ramp": 0.002, "control_integration": "explicit")",
      R"({"kind": "per_frame", "alpha": 1e-5})",

@@ -6,10 +6,14 @@
 #include <random>
 
 #include "scene/cloth_spec.h"
+#include "sim/cape/body_collider.h"
+#include "sim/cape/self_collider.h"
+#include "sim/character/character.h"
 #include "sim/cloth/air_drag_term.h"
 #include "sim/cloth/buckling_spring.h"
 #include "sim/cloth/cloth_terms.h"
 #include "sim/cloth/spring_damping.h"
+#include "character_test_util.h"
 #include "cloth_term_check.h"
 
 namespace kf {
@@ -431,6 +435,139 @@ TEST(ClothForces, ContactTermMatchesFiniteDifferencesInContact) {
     EXPECT_GT(c.force, 0) << "no contact: the check would not cover it";
     EXPECT_GT(c.energy_gradient, 0);
     EXPECT_GT(c.adjoint_x, 0);
+  }
+}
+
+// Friction (FrictionTerm) at each collider, in the sticking regime (slip about 1e-4 m/s, far below the
+// friction_velocity of 0.01) and sliding (about 0.3 m/s): the force, its damping block (the exact df/dv) and
+// the adjoint's x and v shares, which hold the derivatives of the damping block.
+constexpr double kStickingSpeed = 1e-4, kSlidingSpeed = 0.3;
+
+TEST(ClothForces, FrictionTermMatchesFiniteDifferencesOnEveryColliderStickingAndSliding) {
+  const char* colliders[] = {
+      R"({"type": "ground", "center": [0, 0, 0], "axis": [0, 1, 0], "thickness": 0.03, "stiffness": 3000,
+          "friction": 0.5})",
+      R"({"type": "sphere", "center": [0, -0.2, 0], "radius": 0.21, "thickness": 0.03, "stiffness": 3000,
+          "friction": 0.4})",
+      R"({"type": "torus", "center": [0, -0.02, 0], "axis": [0, 1, 0], "radius": 0.12, "tube_radius": 0.03,
+          "thickness": 0.03, "stiffness": 3000, "friction": 0.8})",
+      R"({"type": "capsule", "a": [-0.2, -0.005, 0], "b": [0.2, -0.005, 0], "radius": 0.03, "thickness": 0.03,
+          "stiffness": 3000, "friction": 0.4, "friction_velocity": 0.02})",
+  };
+  for (const char* col : colliders)
+    for (double speed : {kStickingSpeed, kSlidingSpeed}) {
+      SCOPED_TRACE(std::string(col) + " speed " + std::to_string(speed));
+      std::string cloth = kSheet;
+      cloth.insert(cloth.rfind('}'), std::string(R"(, "colliders": [)") + col + "]");
+      const auto sheet = test::term_sheet(cloth);
+      ASSERT_GT(sheet->colliders[0]->friction_params().mu, 0);
+      VecX x, v;
+      test::perturbed_state(*sheet, 0.95, 0.004, speed, 11, x, v);
+      const test::TermCheck c = test::check_term(test::TermProbe<FrictionTerm>(*sheet), x, v, 12);
+      EXPECT_GT(c.force, 0) << "no friction: the check would not cover it";
+      EXPECT_GT(c.adjoint_x, 0);
+      EXPECT_GT(c.adjoint_v, 0);
+    }
+}
+
+TEST(ClothForces, FrictionTermIsNothingWithoutCoefficientOrContact) {
+  std::string cloth = kSheet;
+  cloth.insert(cloth.rfind('}'),
+               R"(, "colliders": [{"type": "ground", "center": [0, 0, 0], "thickness": 0.05, "friction": 0}, {"type": "sphere", "center": [0, -5, 0], "friction": 0.5}])");
+  const auto sheet = test::term_sheet(cloth);
+  VecX x, v;
+  test::perturbed_state(*sheet, 0.95, 0.004, kSlidingSpeed, 13, x, v);
+  VecX f;
+  MatX K, D;
+  test::TermProbe<ContactTerm>(*sheet).eval(x, v, f, K, D);
+  ASSERT_GT(f.cwiseAbs().maxCoeff(), 0.0) << "the sheet must touch the frictionless ground";
+  test::TermProbe<FrictionTerm>(*sheet).eval(x, v, f, K, D);
+  EXPECT_EQ(f.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(D.cwiseAbs().maxCoeff(), 0.0);
+}
+
+// Self contact: a sheet squeezed along its width until neighbours along it are within the pair thickness;
+// friction acts on each pair's relative slip, with the cross couplings in add_adjoint_coupled.
+TEST(ClothForces, FrictionTermMatchesFiniteDifferencesInSelfContact) {
+  for (double speed : {kStickingSpeed, kSlidingSpeed}) {
+    SCOPED_TRACE(speed);
+    auto sheet = test::term_sheet(kSheet);
+    auto self = std::make_unique<SelfCollider>(sheet->particles(), 0.045, 500.0, 0.5 * 0.045);
+    self->set_friction({0.3, 0.01});
+    SelfCollider* pairs = self.get();
+    sheet->colliders.push_back(std::move(self));
+    sheet->prepare = [pairs](const VecX& x, const VecX& v) { pairs->update(x, v); };
+    VecX x, v;
+    test::perturbed_state(*sheet, 0.3, 0.004, speed, 15, x, v);
+    const test::TermCheck c = test::check_term(test::TermProbe<FrictionTerm>(*sheet), x, v, 16);
+    EXPECT_GT(c.force, 0) << "no pair in contact";
+    EXPECT_GT(c.adjoint_x, 0);
+    EXPECT_GT(c.adjoint_v, 0);
+  }
+}
+
+}  // namespace
+}  // namespace kf
+
+// The character's body (BodyCollider suite: Embree runs without floating-point traps): particles just
+// outside faces of the posed, moving body, sticking and sliding relative to its surface.
+namespace kf {
+namespace {
+
+TEST(BodyCollider, FrictionTermMatchesFiniteDifferences) {
+  Character ch(test::character_asset());
+  VecX pose, next;
+  ch.pose(1.5, pose);
+  ch.pose(1.5 + 1.0 / 30, next);
+  const double thickness = 0.01;
+  for (double speed : {kStickingSpeed, kSlidingSpeed}) {
+    SCOPED_TRACE(speed);
+    auto sheet = test::term_sheet(kSheet);
+    auto body = std::make_unique<BodyCollider>(ch.triangles(), ch.vertex_count(), thickness, 2000.0, 0.05, 0.5 * thickness);
+    body->set_pose(pose);
+    const VecX vel = (next - pose) * 30.0;
+    body->set_velocity(vel);
+    body->set_friction({0.5, 0.01});
+    const BodyCollider& b = *body;
+    sheet->colliders.push_back(std::move(body));
+    // Each particle near the middle of a face, within the thickness, where the closest point stays on that
+    // face under the differences' steps; moving with the surface plus a seeded slip of about `speed`.
+    std::mt19937 rng(21);
+    std::uniform_int_distribution<int> pick(0, ch.triangle_count() - 1);
+    std::uniform_real_distribution<double> U(0, 1);
+    std::normal_distribution<double> N;
+    const int p = sheet->particles();
+    VecX x(3 * p), v(3 * p);
+    int placed = 0;
+    for (int trial = 0; trial < 2000 && placed < p; ++trial) {
+      const int f = pick(rng);
+      const Vec3 A = seg(pose, ch.triangles()(f, 0)), B = seg(pose, ch.triangles()(f, 1)), C = seg(pose, ch.triangles()(f, 2));
+      const Vec3 at = (A + B + C) / 3 + (0.002 + 0.005 * U(rng)) * b.query().surface().face_normal(f);
+      const BodyHit hit = b.query().closest(at, 0.05);
+      ContactForce probe;
+      if (!hit.found() || hit.triangle != f || hit.feature != TriangleFeature::kFace ||
+          !b.contact(0, at, Vec3::Zero(), false, probe))
+        continue;
+      bool same = true;
+      for (int d = 0; d < 3 && same; ++d)
+        for (double s : {-1e-4, 1e-4}) {
+          Vec3 y = at;
+          y[d] += s;
+          const BodyHit h = b.query().closest(y, 0.05);
+          same = same && h.triangle == f && h.feature == TriangleFeature::kFace;
+        }
+      if (!same) continue;
+      Vec3 surface = Vec3::Zero();
+      for (int q = 0; q < 3; ++q) surface += hit.barycentric[q] * seg(vel, ch.triangles()(f, q));
+      seg(x, placed) = at;
+      seg(v, placed) = surface + speed * Vec3(N(rng), N(rng), N(rng));
+      ++placed;
+    }
+    ASSERT_EQ(placed, p);
+    const test::TermCheck c = test::check_term(test::TermProbe<FrictionTerm>(*sheet), x, v, 22);
+    EXPECT_GT(c.force, 0);
+    EXPECT_GT(c.adjoint_x, 0);
+    EXPECT_GT(c.adjoint_v, 0);
   }
 }
 

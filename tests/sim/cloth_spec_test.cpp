@@ -76,6 +76,31 @@ TEST(ClothSpec, CollidersAndErrorsNameTheirPlace) {
             std::string::npos);
 }
 
+TEST(ClothSpec, FrictionPerColliderFrictionlessByDefault) {
+  const Scene s = scene_with(
+      R"({"nx": 4, "ny": 4,
+          "colliders": [{"type": "ground"}, {"type": "sphere", "friction": 0.4}, {"type": "torus", "friction": 0.3},
+                        {"type": "capsule", "friction": 0.6}, {"type": "sphere", "friction": 0, "friction_velocity": 0.05}]})");
+  const auto& c = s.cloth->colliders;
+  ASSERT_EQ(c.size(), 5u);
+  EXPECT_EQ(c[0].friction, 0.0);
+  EXPECT_EQ(c[1].friction, 0.4);
+  EXPECT_EQ(c[2].friction, 0.3);
+  EXPECT_EQ(c[3].friction, 0.6);
+  EXPECT_EQ(c[4].friction, 0.0);
+  EXPECT_EQ(c[4].friction_velocity, 0.05);
+  EXPECT_EQ(c[0].friction_velocity, 0.01);
+  // The colliders the system builds carry them.
+  const auto cols = make_colliders(c, 0.5);
+  EXPECT_EQ(cols[2]->friction_params().mu, 0.3);
+  EXPECT_FALSE(cols[4]->friction_params().on());
+  const std::string e = error_of(R"({"colliders": [{"type": "ground"}, {"type": "sphere", "friction": -0.1}]})");
+  EXPECT_NE(e.find("c.json"), std::string::npos) << e;
+  EXPECT_NE(e.find("/cloth/colliders/1/friction"), std::string::npos) << e;
+  EXPECT_NE(error_of(R"({"colliders": [{"type": "ground", "friction_velocity": 0}]})").find("/cloth/colliders/0/friction_velocity"),
+            std::string::npos);
+}
+
 TEST(ClothSpec, ImperfectionIsSeededSubMillimetreAndValidated) {
   const ClothSpec c = *scene_with(R"({"nx": 4, "ny": 4, "imperfection": 5e-4, "imperfection_seed": 3})").cloth;
   EXPECT_EQ(c.imperfection, 5e-4);

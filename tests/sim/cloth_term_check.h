@@ -32,6 +32,9 @@ struct TermSheet {
   ClothSprings springs;
   std::vector<std::unique_ptr<Collider>> colliders;
   std::vector<char> free;
+  // Called with the state before every evaluation: a pair collider (self contact) reads the state it
+  // was updated with. Empty: nothing to update.
+  std::function<void(const VecX& x, const VecX& v)> prepare;
   ClothTermSetup setup() const { return {spec, springs, colliders}; }
   int particles() const { return spec.particles(); }
 };
@@ -60,6 +63,7 @@ class TermProbe {
 
   // f (3p, N) and the definite K (N/m), D (N s/m) (3p x 3p) at (x, v) of step n.
   void eval(const VecX& x, const VecX& v, VecX& f, MatX& K, MatX& D, int n = 0) const {
+    if (sheet_.prepare) sheet_.prepare(x, v);
     const ClothState s{n, x, v, sheet_.mass, sheet_.free};
     f.setZero(dof());
     K.setZero(dof(), dof());
@@ -105,6 +109,7 @@ class TermProbe {
   }
   // The term's shares of xhat and vhat (3p) in the exact adjoint: hs times its rows plus its couplings.
   void adjoint(const ClothAdjoint& a, VecX& xbar, VecX& vbar) const {
+    if (sheet_.prepare) sheet_.prepare(a.x, a.v);
     xbar.setZero(dof());
     vbar.setZero(dof());
     if constexpr (Term::kStencil == ClothStencil::kParticle) {

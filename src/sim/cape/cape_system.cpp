@@ -77,11 +77,13 @@ CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, d
                                              spec_.body_thickness, spec_.body_stiffness, spec_.body_search,
                                              c.contact_ramp * spec_.body_thickness);
   body_ = body.get();
+  body->set_friction({spec_.body_friction, spec_.body_friction_velocity});
   extra.push_back(std::move(body));
   if (spec_.self_collision) {
     auto self = std::make_unique<SelfCollider>(c.particles(), spec_.self_thickness, spec_.self_stiffness,
                                                c.contact_ramp * spec_.self_thickness);
     self_ = self.get();
+    self->set_friction({spec_.self_friction, spec_.self_friction_velocity});
     extra.push_back(std::move(self));
   }
   cloth_ = std::make_unique<ClothSystem>(c, h, std::move(track), std::move(extra));
@@ -108,13 +110,18 @@ void CapeSystem::initial_state(VecX& x, VecX& v) const {
     }
 }
 
-void CapeSystem::prepare(int n, const VecX& x) {
+void CapeSystem::prepare(int n, const VecX& x, const VecX& v) {
   if (posed_step_ != n) {
     pose_at_frame(character_, spec_, n * h_ * fps_, pose_);
     body_->set_pose(pose_);
+    if (body_->friction_params().on()) {  // friction needs the body's velocity over the step
+      pose_at_frame(character_, spec_, (n + 1) * h_ * fps_, next_pose_);
+      body_velocity_ = (next_pose_ - pose_) / h_;
+      body_->set_velocity(body_velocity_);
+    }
     posed_step_ = n;
   }
-  if (self_) self_->update(x);
+  if (self_) self_->update(x, v);
 }
 
 void CapeSystem::set_adjoint(AdjointKind kind) {
@@ -124,7 +131,7 @@ void CapeSystem::set_adjoint(AdjointKind kind) {
 
 bool CapeSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next,
                       StepRecord& record) {
-  prepare(n, x);
+  prepare(n, x, v);
   body_->take_count();
   body_->take_min_distance();
   body_->set_counting(true);
@@ -154,7 +161,7 @@ bool CapeSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& 
 
 void CapeSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX& u, const StepRecord& record,
                               const VecX& xhat1, const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) {
-  prepare(n, x);
+  prepare(n, x, v);
   cloth_->step_adjoint(n, x, v, u, record, xhat1, vhat1, xhat, vhat, uhat);
 }
 

@@ -58,12 +58,12 @@ class CapeSystem final : public System {
   const SelfCollider& self_collider() const { return *self_; }
 
  private:
-  void prepare(int n, const VecX& x);  // body at step n, self hash of x
+  void prepare(int n, const VecX& x, const VecX& v);  // body at step n (and its velocity), self hash of x, v
 
   CharacterSpec spec_;
   double fps_, h_;
   Character character_;
-  VecX pose_;
+  VecX pose_, next_pose_, body_velocity_;  // body vertices at steps n and n + 1 (m), their velocity (m/s)
   int posed_step_ = -1;
   BodyCollider* body_ = nullptr;  // owned by cloth_
   SelfCollider* self_ = nullptr;  // owned by cloth_; null when self-collision is off

@@ -5,12 +5,13 @@
 
 #include "sim/cloth/air_drag_term.h"
 #include "sim/cloth/contact_term.h"
+#include "sim/cloth/friction_term.h"
 #include "sim/cloth/gravity_term.h"
 #include "sim/cloth/spring_damping_term.h"
 #include "sim/cloth/spring_term.h"
 
 namespace kf {
 
-using ClothTerms = std::tuple<GravityTerm, AirDragTerm, SpringTerm, SpringDampingTerm, ContactTerm>;
+using ClothTerms = std::tuple<GravityTerm, AirDragTerm, SpringTerm, SpringDampingTerm, ContactTerm, FrictionTerm>;
 
 }  // namespace kf

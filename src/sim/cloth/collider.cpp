@@ -201,6 +201,7 @@ std::vector<std::unique_ptr<Collider>> make_colliders(const std::vector<Collider
             },
         },
         s.shape));
+    out.back()->set_friction({s.friction, s.friction_velocity});
   }
   return out;
 }

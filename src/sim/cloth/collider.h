@@ -143,7 +143,7 @@ class CapsuleCollider final : public DistanceCollider {
 };
 
 // One collider per spec entry, in order, each shape's class chosen by std::visit (empty for a scene without colliders). ramp_fraction: each
-// contact profile's ramp as a fraction of its collider's thickness.
+// contact profile's ramp as a fraction of its collider's thickness. Each gets its spec's friction.
 std::vector<std::unique_ptr<Collider>> make_colliders(const std::vector<ColliderSpec>& specs, double ramp_fraction);
 
 }  // namespace kf
