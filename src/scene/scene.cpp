@@ -55,7 +55,8 @@ ObjectiveKind parse_shape(Block& b, const ObjectiveSpec&, const Scene& s) {
   if (!s.flock) b.fail("type", "\"shape\" keyframes are for flocks; use \"position\" or \"arch\" for cloth");
   ShapeKeyframe k;
   k.polygon = b.points2("polygon", 3);
-  k.margin = b.number("margin", 0.0, 0.0, 1e4);
+  // Agents settle where the pull ends: a margin inside the edge keeps them counted inside.
+  k.margin = b.number("margin", 0.1 * s.flock->avoidance.radius, 0.0, 1e4);
   Block c = b.child("coverage");
   k.coverage_weight = c.number("weight", 0.0, 0.0, 1e12);
   k.coverage_radius = c.number("radius", s.flock->avoidance.radius, 1e-3, 1e4);
