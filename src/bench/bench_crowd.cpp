@@ -97,7 +97,7 @@ nlohmann::json bench_crowd(const CrowdSweepOptions& o, const std::filesystem::pa
                                      "--max-evaluations", std::to_string(o.evaluations), "--quiet"};
     if (max_gb > 0) {
       args.push_back("--max-memory");
-      args.push_back(fmt(max_gb));
+      args.push_back(std::to_string(std::llround(max_gb * 1e9)));  // bytes
     }
     const ChildRun c = run_child(args);
     std::ifstream rin(run / "report.json");

@@ -186,13 +186,15 @@ Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensit
     d.line = "reached its keyframes" + budget;
     return d;
   }
-  d.outcome = d.failed() ? (d.progress ? "not_reached" : "no_progress") : "near";
+  d.outcome = !d.progress ? "no_progress" : d.far ? "not_reached" : "near";
   std::string what = worst->name + " is " + worst->error_after + " from its target (tolerance " + worst->tolerance +
                      "; " + worst->error_before + " uncontrolled)";
   if (worst->tolerance.find("inside") != std::string::npos)
     what = worst->name + " ends at " + worst->error_after + " (needs " + worst->tolerance + "; " +
            worst->error_before + " uncontrolled)";
-  std::string head = d.failed() ? (d.progress ? "keyframes not reached: " : "no progress: ") : "near its keyframes: ";
+  std::string head = !d.progress ? "no progress: "
+                     : d.far      ? "keyframes not reached: "
+                                  : "keyframes not reached, but near: ";
   if (!d.progress)
     head += format("the keyframe terms went from %.3g to %.3g; ", facts.keyframe_objective_start,
                    facts.keyframe_objective_end);
