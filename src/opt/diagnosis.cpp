@@ -192,7 +192,9 @@ std::string miss_text(const KeyframeJudgement& worst) {
 }
 
 std::string verdict_head(const Diagnosis& d, const RunFacts& facts) {
-  std::string head = d.failed() ? (d.progress ? "keyframes not reached: " : "no progress: ") : "near its keyframes: ";
+  std::string head = !d.progress ? "no progress: "
+                     : d.far      ? "keyframes not reached: "
+                                  : "keyframes not reached, but near: ";
   if (!d.progress)
     head += format("the keyframe terms went from %.3g to %.3g; ", facts.keyframe_objective_start,
                    facts.keyframe_objective_end);
@@ -258,7 +260,7 @@ Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensit
     d.line = "reached its keyframes" + budget;
     return d;
   }
-  d.outcome = d.failed() ? (d.progress ? "not_reached" : "no_progress") : "near";
+  d.outcome = !d.progress ? "no_progress" : d.far ? "not_reached" : "near";
   d.line = verdict_head(d, facts) + miss_text(*worst) + budget + "; " + likely_cause(s, facts);
   return d;
 }

@@ -3,8 +3,9 @@
 //
 // Each keyframe is judged by its figure measure against a tolerance (keyframe_tolerance below); its miss is
 // the error over the tolerance, so a miss of at most 1 is met. The run fails (keyframe optimize exits with
-// kExitNotReached) when some keyframe is not met and either the keyframe terms of φ fell by less than half
-// (no meaningful progress) or some keyframe misses by more than kFarMiss tolerances. The cause comes from
+// kExitNotReached) when some keyframe is not met; the outcome tells a near miss (progress, every keyframe
+// within kFarMiss tolerances) from a far one and from no meaningful progress (the keyframe terms of φ fell
+// by less than half). The cause comes from
 // measurements at the start: how much the motion amplifies a perturbation on its way to the keyframe (the
 // gradient of φ with respect to a force held over each frame, from one adjoint pass) and how noisy φ is
 // under perturbations of 1e-9 (a bifurcation such as a flat sheet released in its own plane).
@@ -17,8 +18,8 @@
 
 namespace kf {
 
-// A keyframe whose error is more than this many tolerances is far from its target: the run failed even if
-// its objective fell.
+// A keyframe whose error is more than this many tolerances is far from its target (outcome "not_reached"
+// rather than "near").
 constexpr double kFarMiss = 3.0;
 
 // One keyframe (objective) of the scene, judged before (the uncontrolled run) and after the optimisation.
@@ -79,7 +80,7 @@ struct Diagnosis {
   bool reached = false;   // every judged keyframe met
   bool progress = false;  // the keyframe terms fell to at most half
   bool far = false;       // some keyframe misses by more than kFarMiss tolerances
-  bool failed() const { return !reached && (!progress || far); }
+  bool failed() const { return !reached; }
   std::string outcome;    // "reached", "near", "not_reached", "no_progress"
   std::string line;       // one line for the user: what happened, the cause, what to change
   nlohmann::json to_json() const;

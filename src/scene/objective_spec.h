@@ -76,9 +76,12 @@ inline const char* control_kind_name(ControlKind k) {
   return kNames[int(k)];
 }
 
+// The effort weight initial-velocity controls default to.
+constexpr double kInitialVelocityAlpha = 1e-6;
+
 struct ControlSpec {
   ControlKind kind = ControlKind::kPerStep;
-  double alpha = 1e-4;  // weight of the control effort ½α‖u‖²
+  double alpha = 1e-4;  // weight of the control effort ½α‖u‖² (forces' default; see kInitialVelocityAlpha)
   // Forces act from this frame on (per_step / per_frame); earlier steps are uncontrolled. A blend whose
   // start flails against the body is steered over its last frames, where the gradient stays finite.
   int from_frame = 0;

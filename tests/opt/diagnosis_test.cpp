@@ -79,9 +79,10 @@ TEST(Diagnosis, OutcomeFollowsProgressAndDistance) {
   EXPECT_EQ(d.outcome, "reached");
   EXPECT_FALSE(d.failed());
   EXPECT_NE(d.line.find("budget"), std::string::npos) << d.line;
-  d = diagnose(one_keyframe(15, 2), smooth, facts(10, 0.1));  // progress, within kFarMiss tolerances
+  d = diagnose(one_keyframe(15, 2), smooth, facts(10, 0.1));  // progress, within kFarMiss tolerances: still a miss
   EXPECT_EQ(d.outcome, "near");
-  EXPECT_FALSE(d.failed());
+  EXPECT_TRUE(d.failed());
+  EXPECT_NE(d.line.find("not reached, but near"), std::string::npos) << d.line;
   d = diagnose(one_keyframe(15, 5), smooth, facts(10, 1));  // progress, but far
   EXPECT_EQ(d.outcome, "not_reached");
   EXPECT_TRUE(d.failed());
