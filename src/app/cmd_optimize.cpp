@@ -17,10 +17,11 @@ void add_optimize_options(CLI::App* sub, OptimizeOptions& o) {
                   "and recompute the rest (0 = keep all states)")
       ->check(CLI::Range(0, 10000000));
   sub->add_option("--max-memory", o.max_memory,
-                  "override the scene's optimizer.max_memory: memory budget in GB (1e9 bytes; 0 = half the "
-                  "machine's); when keeping every step for the adjoint is estimated to pass it, the run "
-                  "checkpoints instead (same gradient, about one more forward pass)")
-      ->check(CLI::Range(0.0, 1e6));
+                  "the memory the run may use, a size such as 4G, 512M or 1.5GiB (K, M, G, T are powers of 1024; "
+                  "a plain number is bytes; 0 = the default), as `simulate` takes it; overrides the scene's "
+                  "optimizer.max_memory (GB) and defaults to half the machine's: when keeping every step for the "
+                  "adjoint is estimated to pass it, the run checkpoints instead (same gradient, about one more "
+                  "forward pass); a run that cannot fit in the machine's memory even checkpointed is refused up front");
   sub->add_option("--adjoint", o.adjoint,
                   "override the scene's optimizer.adjoint for cloth: exact (the transpose of the step's own "
                   "Jacobian) or swap (the paper's integrator-swapping approximation)")

@@ -23,8 +23,9 @@ void add_simulate_command(CLI::App& app) {
   auto max_memory = std::make_shared<std::string>();
   sub->add_option("--out", *out, "run directory (default: out/<scene>/)");
   sub->add_option("--max-memory", *max_memory,
-                  "refuse the run up front when its estimated memory exceeds this (e.g. 4G; default: the "
-                  "machine's memory)");
+                  "the memory the run may use, a size such as 4G, 512M or 1.5GiB (K, M, G, T are powers of "
+                  "1024; a plain number is bytes; 0 = the default, the machine's memory), as `optimize` takes "
+                  "it: a run estimated to need more is refused up front");
   sub->callback([=] {
     Scene scene = load_scene(*scene_path);
     if (scene.cloth) scene.cloth->use_motion_tolerance();

@@ -75,6 +75,7 @@ std::uint64_t parse_memory_size(const std::string& text) {
   const std::string unit = m[2];
   const int shift = unit.empty() ? 0 : std::string("KMGT").find(char(std::toupper(unit[0]))) + 1;
   v *= std::pow(1024.0, shift);
+  if (v == 0) return 0;  // the command's default
   if (!(v >= 1) || v > 1e18) throw InputError("--max-memory: out of range, got \"" + text + "\"");
   return std::uint64_t(v);
 }

@@ -24,7 +24,8 @@ RunMemory optimize_memory(const Scene& scene, int substeps, int checkpoint_every
 // The machine's memory: MemTotal, or the cgroup's memory.max when that is lower.
 std::uint64_t machine_memory();
 
-// "4G", "512M", "1.5GiB", "100000" (bytes) -> bytes; throws InputError naming --max-memory otherwise.
+// "4G", "512M", "1.5GiB", "100000" (bytes) -> bytes (K, M, G, T: powers of 1024); "0" -> 0 (the command's
+// default). Throws InputError naming --max-memory otherwise. What simulate's and optimize's --max-memory take.
 std::uint64_t parse_memory_size(const std::string& text);
 
 // Throws InputError "FILE: needs at least 12.7 GiB of memory (...), more than the machine's 7.8 GiB; ..."

@@ -330,6 +330,8 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
                           : std::max(1, int(std::sqrt(double(scene.time.frames) * substeps)));
     return optimize_memory(scene, substeps, every);
   };
+  // --max-memory, as simulate reads it (0 or absent: the scene's optimizer.max_memory, else half the machine's).
+  const std::uint64_t max_memory = opt.max_memory.empty() ? 0 : parse_memory_size(opt.max_memory);
   check_memory(scene, least_memory(scene.time.substeps), 0);
   // The stages of coarse-to-fine continuation; a resumed run continues in the last stage.
   const StagePlan plan = plan_stages(scene);
@@ -384,8 +386,9 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     job.problem = std::make_unique<Problem>(stage_scene, time, *job.sys);
     Problem& problem = *job.problem;
     if (opt.checkpoint_every >= 0) problem.set_checkpoint_every(opt.checkpoint_every);
-    const double max_gb = opt.max_memory >= 0 ? opt.max_memory : scene.optimizer.max_memory;
-    const std::size_t budget = max_gb > 0 ? std::size_t(max_gb * 1e9) : default_memory_budget();
+    const std::size_t budget = max_memory > 0                     ? std::size_t(max_memory)
+                               : scene.optimizer.max_memory > 0 ? std::size_t(scene.optimizer.max_memory * 1e9)
+                                                                : default_memory_budget();
     job.memory_budget_gb = budget / 1e9;
     std::string memory_line;
     problem.set_memory_budget(rollout_budget(problem, *job.sys, scene.optimizer.memory, budget,

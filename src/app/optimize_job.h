@@ -15,7 +15,7 @@ struct OptimizeOptions {
   bool quiet = false;         // no per-evaluation lines on stdout
   std::string resume;         // run directory to continue from (its scene.json and controls.bin)
   int checkpoint_every = -1;  // override the scene's optimizer.checkpoint_every when >= 0
-  double max_memory = -1;     // override the scene's optimizer.max_memory (GB) when >= 0
+  std::string max_memory;     // override the scene's optimizer.max_memory when not empty: a size ("4G", parse_memory_size)
   std::string adjoint;        // override the scene's optimizer.adjoint when not empty ("exact" | "swap")
   double max_seconds = -1;    // override the scene's optimizer.max_seconds (per stage) when >= 0
 };

@@ -89,7 +89,7 @@ CrowdPoint run_crowd_point(const nlohmann::json& base, int agents, double max_gb
                                    "--max-evaluations", std::to_string(evaluations), "--quiet"};
   if (max_gb > 0) {
     args.push_back("--max-memory");
-    args.push_back(fmt(max_gb));
+    args.push_back(std::to_string(std::llround(max_gb * 1e9)));  // bytes
   }
   CrowdPoint p{agents, max_gb, run_child(args), {}};
   std::ifstream rin(run / "report.json");

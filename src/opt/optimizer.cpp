@@ -154,7 +154,10 @@ OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX&
       // LBFGS gives up this way when the line search cannot make progress; the best point stands.
       d.result.status = std::string("stopped: line search made no progress (") + e.what() + ")";
     }
-    // NLopt may report a forced stop as a generic failure; what stopped it is known here.
+    // NLopt may report a forced stop as a generic failure; what stopped it is known here. A stop asked for
+    // during the evaluation NLopt ended on (its line search gave up, or it converged, without asking again)
+    // is an interruption too: the run stops because it was told to, whatever NLopt said.
+    if (stop && stop->load()) d.result.interrupted = true;
     if (d.result.interrupted) d.result.status = "interrupted";
     else if (d.limit_reached) d.result.status = status_name(nlopt::MAXEVAL_REACHED);
   }

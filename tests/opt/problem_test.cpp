@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <atomic>
+
 #include "opt/gradcheck.h"
 #include "opt/optimizer.h"
 #include "opt/problem.h"
@@ -147,6 +149,27 @@ TEST(Optimizer, ReducesTheObjectiveByOrdersOfMagnitude) {
   const OptimizeResult r = minimize(problem, spec, z0);
   EXPECT_LT(r.phi, 1e-3 * phi0) << r.status;
   EXPECT_GT(r.evaluations, 2);
+}
+
+TEST(Optimizer, AStopAskedForDuringTheLastEvaluationIsAnInterruption) {
+  // NLopt may end on the evaluation during which the stop arrived without asking for another (its
+  // line search gives up, it converges, or its own limit is reached): the run was still told to stop, and
+  // says only that. Here NLopt's limit of one evaluation ends it right after the stop is asked for.
+  Scene scene = toy_scene("per_frame", 2);
+  test::ToySystem sys(4, scene.time.h());
+  Problem problem(scene, scene.time, sys);
+  OptimizerSpec spec;
+  spec.max_evaluations = 1;
+  std::atomic<bool> stop{false};
+  const OptimizeResult r = minimize(problem, spec, problem.initial_guess(), [&](const EvaluationRecord&) { stop = true; }, &stop);
+  EXPECT_EQ(r.evaluations, 1);
+  EXPECT_TRUE(r.interrupted);
+  EXPECT_EQ(r.status, "interrupted");
+  // Without a stop the same run ends at its limit.
+  std::atomic<bool> no_stop{false};
+  const OptimizeResult whole = minimize(problem, spec, problem.initial_guess(), {}, &no_stop);
+  EXPECT_FALSE(whole.interrupted);
+  EXPECT_EQ(whole.status, "evaluation limit reached");
 }
 
 TEST(Optimizer, RecoversFromDivergedTrialSteps) {

@@ -1,6 +1,10 @@
 // Memory is estimated before a run: one that cannot fit is refused at once with the estimate (exit 3,
 // nothing written) instead of paging for minutes and ending in std::bad_alloc; a checkpoint spacing past
 // the end of a run costs no more than keeping every state.
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
 #include "cli_harness.h"
 #include "core/error.h"
 
@@ -40,6 +44,28 @@ TEST_F(MemoryRefusal, MaxMemoryIsALimitTheEstimateIsHeldTo) {
   // The fuzz corpus's million agents: refused at once under a 1 GiB limit (it took 85 s and 5.7 GB before).
   write("big.json", R"({"flock": {"spawn": {"radius": 1e6}, "agents": 1000000}})");
   expect_refused("simulate big.json --max-memory 1G", "big.json: needs at least 9.0 GiB of memory");
+}
+
+TEST_F(MemoryRefusal, OptimizeTakesMaxMemoryInTheFormSimulateTakes) {
+  // The same size text as simulate's; for optimize it is the budget that picks the checkpoint spacing.
+  write("f.json", small_flock_scene(6));
+  expect_refused("optimize f.json --quiet --max-memory lots",
+                 "--max-memory: expected a size such as 4G, 512M or 1.5GiB, got \"lots\"");
+  const auto budget_of = [&](const std::string& size, const std::string& out) {
+    const CliResult r = run_keyframe("optimize f.json --quiet --max-memory " + size + " --out " + out, dir_);
+    EXPECT_TRUE(r.code == 0 || r.code == 7) << r.output;
+    std::ifstream in(dir_ / out / "report.json");
+    return in ? nlohmann::json::parse(in) : nlohmann::json{};
+  };
+  const nlohmann::json roomy = budget_of("1.5M", "roomy"), tight = budget_of("1K", "tight");
+  ASSERT_TRUE(roomy.contains("memory_budget_gb") && tight.contains("memory_budget_gb"));
+  EXPECT_DOUBLE_EQ(roomy.at("memory_budget_gb").get<double>(), 1.5 * 1048576 / 1e9);
+  EXPECT_EQ(roomy.at("checkpoint_every_for_budget").get<int>(), 0);  // every step fits in 1.5 MiB
+  EXPECT_DOUBLE_EQ(tight.at("memory_budget_gb").get<double>(), 1024 / 1e9);
+  EXPECT_GT(tight.at("checkpoint_every_for_budget").get<int>(), 0);  // 1 KiB does not: checkpointed
+  // 0 is each command's default.
+  EXPECT_EQ(run_keyframe("simulate f.json --max-memory 0 --out sim", dir_).code, 0);
+  EXPECT_GT(budget_of("0", "default").at("memory_budget_gb").get<double>(), 0.01);
 }
 
 TEST_F(MemoryRefusal, CheckpointSpacingPastTheEndCostsNoMoreThanKeepingEveryState) {
