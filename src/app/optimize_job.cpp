@@ -204,12 +204,12 @@ struct JobResult {
   Diagnosis diagnosis;
 };
 
-// The rollout budget of a problem within a run's budget (bytes): what the optimiser's vectors leave, and the
-// line that says whether checkpointing is on. At least 1 byte, so a run over budget checkpoints as tightly as
-// it can.
-std::size_t rollout_budget(const Problem& problem, System& sys, int lbfgs_memory, std::size_t budget, int& every,
-                           std::string& line) {
-  const std::size_t fixed = optimizer_bytes(std::size_t(problem.size()), lbfgs_memory);
+// The rollout budget of a problem within a run's budget (bytes): what the optimiser's vectors and `held` (the
+// job's other memory) leave, and the line that says whether checkpointing is on. At least 1 byte, so a run
+// over budget checkpoints as tightly as it can.
+std::size_t rollout_budget(const Problem& problem, System& sys, int lbfgs_memory, std::size_t held,
+                           std::size_t budget, int& every, std::string& line) {
+  const std::size_t fixed = optimizer_bytes(std::size_t(problem.size()), lbfgs_memory) + held;
   const std::size_t left = budget > fixed ? budget - fixed : 1;
   int costed = 0;
   for (int n = 0; n <= problem.time().steps(); ++n) costed += problem.active(n);
@@ -369,6 +369,8 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (resuming) staged.copy_from_target([](const std::string&) { return true; });
   else naming_run_dir(staged, [&] { prepare_run_dir(work, scene); });
 
+  std::uint64_t all_evaluations = 0;  // recorded on one tape over all stages
+  for (const auto& st : stages) all_evaluations += std::uint64_t(std::max(st.max_evaluations, 1));
   EvaluationLog elog(opt.quiet);
   if (!plan.why.empty() && !resuming) elog.say(plan.why);
   SignalGuard signals;
@@ -391,7 +393,12 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
                                                                 : default_memory_budget();
     job.memory_budget_gb = budget / 1e9;
     std::string memory_line;
-    problem.set_memory_budget(rollout_budget(problem, *job.sys, scene.optimizer.memory, budget,
+    // Besides the optimiser and the rollout: the recorded evaluations (points and gradients, for a resume)
+    // and, at the end, the run directory's two trajectories (the uncontrolled run and the result).
+    const std::size_t held =
+        job.tape.bytes_for(std::uint64_t(problem.size()), all_evaluations) +
+        2 * std::size_t(scene.time.frames + 1) * 2 * std::size_t(job.sys->dof()) * sizeof(double);
+    problem.set_memory_budget(rollout_budget(problem, *job.sys, scene.optimizer.memory, held, budget,
                                              job.auto_checkpoint_every, memory_line));
     if (problem.checkpoint_every() > 0) job.auto_checkpoint_every = 0;
     if (z.size() == 0) z = problem.initial_guess();
