@@ -204,12 +204,12 @@ struct JobResult {
   Diagnosis diagnosis;
 };
 
-// The rollout budget of a problem within a run's budget (bytes): what the optimiser's vectors leave, and the
-// line that says whether checkpointing is on. At least 1 byte, so a run over budget checkpoints as tightly as
-// it can.
-std::size_t rollout_budget(const Problem& problem, System& sys, int lbfgs_memory, std::size_t budget, int& every,
-                           std::string& line) {
-  const std::size_t fixed = optimizer_bytes(std::size_t(problem.size()), lbfgs_memory);
+// The rollout budget of a problem within a run's budget (bytes): what the optimiser's vectors and `held` (the
+// job's other memory) leave, and the line that says whether checkpointing is on. At least 1 byte, so a run
+// over budget checkpoints as tightly as it can.
+std::size_t rollout_budget(const Problem& problem, System& sys, int lbfgs_memory, std::size_t held,
+                           std::size_t budget, int& every, std::string& line) {
+  const std::size_t fixed = optimizer_bytes(std::size_t(problem.size()), lbfgs_memory) + held;
   const std::size_t left = budget > fixed ? budget - fixed : 1;
   int costed = 0;
   for (int n = 0; n <= problem.time().steps(); ++n) costed += problem.active(n);
@@ -386,6 +386,7 @@ struct JobContext {
   const fs::path& dir;
   bool resuming;
   std::uint64_t max_memory;  // --max-memory in bytes (0: the scene's optimizer.max_memory)
+  std::uint64_t all_evaluations;  // recorded on one tape over all stages
   EvaluationLog& elog;
 };
 
@@ -408,7 +409,12 @@ std::string set_up_stage(const JobContext& c, const StageSpec& stage, JobResult&
                                                                 : default_memory_budget();
   job.memory_budget_gb = budget / 1e9;
   std::string memory_line;
-  problem.set_memory_budget(rollout_budget(problem, *job.sys, c.scene.optimizer.memory, budget,
+  // Besides the optimiser and the rollout: the recorded evaluations (points and gradients, for a resume)
+  // and, at the end, the run directory's two trajectories (the uncontrolled run and the result).
+  const std::size_t held =
+      job.tape.bytes_for(std::uint64_t(problem.size()), c.all_evaluations) +
+      2 * std::size_t(c.scene.time.frames + 1) * 2 * std::size_t(job.sys->dof()) * sizeof(double);
+  problem.set_memory_budget(rollout_budget(problem, *job.sys, c.scene.optimizer.memory, held, budget,
                                            job.auto_checkpoint_every, memory_line));
   if (problem.checkpoint_every() > 0) job.auto_checkpoint_every = 0;
   if (z.size() == 0) z = problem.initial_guess();
@@ -515,10 +521,12 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (resuming) staged.copy_from_target([](const std::string&) { return true; });
   else naming_run_dir(staged, [&] { prepare_run_dir(work, scene); });
 
+  std::uint64_t all_evaluations = 0;
+  for (const auto& st : stages) all_evaluations += std::uint64_t(std::max(st.max_evaluations, 1));
   EvaluationLog elog(opt.quiet);
   if (!plan.why.empty() && !resuming) elog.say(plan.why);
   SignalGuard signals;
-  const JobContext context{scene, opt, plan, dir, resuming, max_memory, elog};
+  const JobContext context{scene, opt, plan, dir, resuming, max_memory, all_evaluations, elog};
   for (size_t s = 0; s < stages.size() && !job.interrupted; ++s) run_job_stage(context, stages, s, job, z_time);
 
   nlohmann::json report;

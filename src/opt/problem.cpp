@@ -50,6 +50,7 @@ double Problem::evaluate(const VecX& z, VecX* grad) {
   options.checkpoint_every = grad ? checkpoint_every_ : 0;
   options.memory_budget = grad ? memory_budget_ : 0;
   options.keep_for = this;
+  options.tape = grad != nullptr;  // a value alone needs no tape: a checkpointed run's last simulation stays small
   bool ok = simulate(sys_, x0_, v0_, time_.steps(), u_at, rollout_, options);
   long double phi = 0;  // extended, like each term's sum: φ's round-off is a gradient check's floor
   breakdown_.clear();
