@@ -91,15 +91,15 @@ std::vector<std::vector<std::string>> clip_commands(const ClipRequest& r, const 
   return commands;
 }
 
-std::vector<fs::path> make_clip(const ClipRequest& r) {
+namespace {
+
+void check_clip_request(const ClipRequest& r) {
   if (!r.mp4 && !r.gif) throw InputError("clip: nothing to make (choose MP4 and/or --gif)");
   if (r.fps < 0.0 || r.fps > 1000.0) throw InputError("clip: --fps " + std::to_string(r.fps) + " out of range (0..1000)");
-  const fs::path frames = r.run_dir / "frames";
-  const std::string stem = r.turntable ? "turntable" : "frame";
-  const std::string render_hint = r.turntable ? "keyframe render " + r.run_dir.string() + " --turntable 120"
-                                              : "keyframe render " + r.run_dir.string();
-  if (!fs::is_directory(r.run_dir)) throw InputError(r.run_dir.string() + ": not a run directory (does not exist)");
-  // Frames must run without gaps: ffmpeg's image reader stops at the first missing number.
+}
+
+// The numbers of the frames STEM_NNNN.png in `frames`.
+std::set<int> frame_numbers(const fs::path& frames, const std::string& stem) {
   std::set<int> numbers;
   const std::regex re(stem + R"(_(\d{4,})\.png)");
   std::error_code ec;
@@ -109,8 +109,12 @@ std::vector<fs::path> make_clip(const ClipRequest& r) {
       const std::string name = e.path().filename().string();
       if (std::regex_match(name, m, re)) numbers.insert(std::stoi(m[1]));
     }
-  if (numbers.empty())
-    throw InputError(frames.string() + ": no " + stem + "_NNNN.png frames to encode (run `" + render_hint + "` first)");
+  return numbers;
+}
+
+// The last frame of the run that starts at the first; frames must run without gaps: ffmpeg's image
+// reader stops at the first missing number.
+int last_of_gapless_run(const fs::path& frames, const std::set<int>& numbers) {
   const int first = *numbers.begin();
   int last = first;
   while (numbers.count(last + 1)) ++last;
@@ -118,7 +122,11 @@ std::vector<fs::path> make_clip(const ClipRequest& r) {
     throw InputError(frames.string() + ": frames " + std::to_string(first) + ".." + std::to_string(last) +
                      " are followed by a gap (frame " + std::to_string(last + 1) +
                      " is missing); re-render the frames without gaps");
-  // ffmpeg skips a frame it cannot decode and still exits 0; every frame is read here first instead.
+  return last;
+}
+
+// ffmpeg skips a frame it cannot decode and still exits 0; every frame is read here first instead.
+void check_frames_decode(const fs::path& frames, const std::string& stem, int first, int last) {
   int width = 0, height = 0;
   char name[64];
   for (int k = first; k <= last; ++k) {
@@ -131,14 +139,12 @@ std::vector<fs::path> make_clip(const ClipRequest& r) {
                        " pixels, but frame " + std::to_string(first) + " has " + std::to_string(width) + "x" +
                        std::to_string(height) + "; re-render the frames at one size");
   }
-  const fs::path ffmpeg = find_program(r.ffmpeg);
-  if (ffmpeg.empty()) throw OutputError("clip: cannot run \"" + r.ffmpeg + "\"");
-  const double fps = r.fps > 0.0 ? r.fps : trajectory_fps(r.run_dir);
-  std::vector<fs::path> targets, temps;
-  if (r.mp4) targets.push_back(r.run_dir / (stem == "frame" ? "clip.mp4" : "turntable.mp4"));
-  if (r.gif) targets.push_back(r.run_dir / (stem == "frame" ? "clip.gif" : "turntable.gif"));
-  for (const auto& t : targets) temps.push_back(t.string() + ".partial");
-  const auto commands = clip_commands(r, (frames / (stem + "_%04d.png")).string(), first, fps, temps);
+}
+
+// Runs each command writing its `.partial` file; on a failure removes them all.
+void run_encoders(const fs::path& ffmpeg, const std::vector<std::vector<std::string>>& commands,
+                  const std::vector<fs::path>& targets, const std::vector<fs::path>& temps) {
+  std::error_code ec;
   for (size_t k = 0; k < commands.size(); ++k) {
     const int status = run_program(ffmpeg, commands[k]);
     if (status != 0) {
@@ -146,6 +152,31 @@ std::vector<fs::path> make_clip(const ClipRequest& r) {
       throw OutputError("clip: ffmpeg failed with status " + std::to_string(status) + " writing " + targets[k].string());
     }
   }
+}
+
+}  // namespace
+
+std::vector<fs::path> make_clip(const ClipRequest& r) {
+  check_clip_request(r);
+  const fs::path frames = r.run_dir / "frames";
+  const std::string stem = r.turntable ? "turntable" : "frame";
+  const std::string render_hint = r.turntable ? "keyframe render " + r.run_dir.string() + " --turntable 120"
+                                              : "keyframe render " + r.run_dir.string();
+  if (!fs::is_directory(r.run_dir)) throw InputError(r.run_dir.string() + ": not a run directory (does not exist)");
+  const std::set<int> numbers = frame_numbers(frames, stem);
+  if (numbers.empty())
+    throw InputError(frames.string() + ": no " + stem + "_NNNN.png frames to encode (run `" + render_hint + "` first)");
+  const int first = *numbers.begin(), last = last_of_gapless_run(frames, numbers);
+  check_frames_decode(frames, stem, first, last);
+  const fs::path ffmpeg = find_program(r.ffmpeg);
+  if (ffmpeg.empty()) throw OutputError("clip: cannot run \"" + r.ffmpeg + "\"");
+  const double fps = r.fps > 0.0 ? r.fps : trajectory_fps(r.run_dir);
+  std::vector<fs::path> targets, temps;
+  if (r.mp4) targets.push_back(r.run_dir / (stem == "frame" ? "clip.mp4" : "turntable.mp4"));
+  if (r.gif) targets.push_back(r.run_dir / (stem == "frame" ? "clip.gif" : "turntable.gif"));
+  for (const auto& t : targets) temps.push_back(t.string() + ".partial");
+  run_encoders(ffmpeg, clip_commands(r, (frames / (stem + "_%04d.png")).string(), first, fps, temps), targets, temps);
+  std::error_code ec;
   for (size_t k = 0; k < targets.size(); ++k) {
     fs::rename(temps[k], targets[k], ec);
     if (ec) throw OutputError(targets[k].string() + ": cannot write (" + ec.message() + ")");

@@ -88,72 +88,102 @@ std::string threshold_failure(const ImageMetrics& m, const CompareThresholds& t)
   return {};
 }
 
-CompareResult compare_frames(const CompareRequest& r) {
-  const CompareThresholds& t = r.thresholds;
+namespace {
+
+void check_thresholds(const CompareThresholds& t) {
   if (t.tolerance < 0 || t.tolerance > 255) throw InputError("compare: tolerance must be 0..255 levels");
   if (!(t.max_fraction >= 0.0 && t.max_fraction <= 1.0)) throw InputError("compare: max fraction must be 0..1");
   if (!(t.max_mean >= 0.0) || !(t.min_psnr >= 0.0)) throw InputError("compare: thresholds must not be negative");
+}
+
+// The two frame directories and the PNG names each holds.
+struct FramePairs {
+  fs::path actual, reference;
+  std::set<std::string> names, ref_names;
+};
+
+FramePairs find_frame_pairs(const CompareRequest& r) {
+  FramePairs p;
   std::error_code ec;
   if (!fs::is_directory(r.actual, ec)) throw InputError(r.actual.string() + ": not a directory");
-  const fs::path actual = frames_dir(r.actual);
-  const std::set<std::string> names = png_names(actual);
-  if (names.empty()) throw InputError(actual.string() + ": no PNG frames to compare (empty directory)");
+  p.actual = frames_dir(r.actual);
+  p.names = png_names(p.actual);
+  if (p.names.empty()) throw InputError(p.actual.string() + ": no PNG frames to compare (empty directory)");
   const bool have_reference = fs::is_directory(r.reference, ec);
   if (!have_reference && !r.update)
     throw InputError(r.reference.string() + ": no such reference directory (--update creates it from the frames)");
-  const fs::path reference = have_reference ? frames_dir(r.reference) : r.reference;
-  const std::set<std::string> ref_names = have_reference ? png_names(reference) : std::set<std::string>{};
-  if (ref_names.empty() && !r.update)
-    throw InputError(reference.string() + ": no PNG reference frames (empty directory; --update fills it)");
-  for (const auto& n : ref_names)
-    if (!names.count(n))
-      throw InputError((actual / n).string() + ": missing (the reference " + (reference / n).string() + " has it)");
-  if (!r.update)
-    for (const auto& n : names)
-      if (!ref_names.count(n))
-        throw InputError((reference / n).string() + ": missing reference for " + (actual / n).string() +
-                         " (--update accepts new frames)");
+  p.reference = have_reference ? frames_dir(r.reference) : r.reference;
+  p.ref_names = have_reference ? png_names(p.reference) : std::set<std::string>{};
+  if (p.ref_names.empty() && !r.update)
+    throw InputError(p.reference.string() + ": no PNG reference frames (empty directory; --update fills it)");
+  return p;
+}
 
-  // First pass: metrics only, so that bad input stops us before anything is written.
+// Every reference frame needs a frame; every frame needs a reference unless new ones are accepted.
+void check_frames_paired(const FramePairs& p, bool update) {
+  for (const auto& n : p.ref_names)
+    if (!p.names.count(n))
+      throw InputError((p.actual / n).string() + ": missing (the reference " + (p.reference / n).string() +
+                       " has it)");
+  if (!update)
+    for (const auto& n : p.names)
+      if (!p.ref_names.count(n))
+        throw InputError((p.reference / n).string() + ": missing reference for " + (p.actual / n).string() +
+                         " (--update accepts new frames)");
+}
+
+FrameResult measure_frame(const FramePairs& p, const std::string& n, const CompareThresholds& t) {
+  FrameResult f;
+  f.name = n;
+  // Sizes from the headers first: a mismatch is reported before a large image is decoded.
+  const PngHeader ha = read_png_header(p.actual / n);
+  if (p.ref_names.count(n)) {
+    const PngHeader hb = read_png_header(p.reference / n);
+    if (ha.width != hb.width || ha.height != hb.height)
+      throw InputError((p.actual / n).string() + ": " + std::to_string(ha.width) + "x" + std::to_string(ha.height) +
+                       " pixels, but the reference " + (p.reference / n).string() + " has " +
+                       std::to_string(hb.width) + "x" + std::to_string(hb.height));
+  }
+  const Image a = read_png(p.actual / n);
+  f.width = a.width;
+  f.height = a.height;
+  if (p.ref_names.count(n)) {
+    const Image b = read_png(p.reference / n);
+    f.metrics = image_metrics(a, b, t.tolerance);
+    f.why = threshold_failure(f.metrics, t);
+  } else {
+    f.is_new = true;
+  }
+  f.pass = f.why.empty();
+  return f;
+}
+
+// Metrics only, so that bad input stops us before anything is written.
+CompareResult measure_frames(const FramePairs& p, const CompareThresholds& t) {
   CompareResult res;
-  for (const auto& n : names) {
-    FrameResult f;
-    f.name = n;
-    // Sizes from the headers first: a mismatch is reported before a large image is decoded.
-    const PngHeader ha = read_png_header(actual / n);
-    if (ref_names.count(n)) {
-      const PngHeader hb = read_png_header(reference / n);
-      if (ha.width != hb.width || ha.height != hb.height)
-        throw InputError((actual / n).string() + ": " + std::to_string(ha.width) + "x" + std::to_string(ha.height) +
-                         " pixels, but the reference " + (reference / n).string() + " has " +
-                         std::to_string(hb.width) + "x" + std::to_string(hb.height));
-    }
-    const Image a = read_png(actual / n);
-    f.width = a.width;
-    f.height = a.height;
-    if (ref_names.count(n)) {
-      const Image b = read_png(reference / n);
-      f.metrics = image_metrics(a, b, t.tolerance);
-      f.why = threshold_failure(f.metrics, t);
-    } else {
-      f.is_new = true;
-      ++res.added;
-    }
-    f.pass = f.why.empty();
+  for (const auto& n : p.names) {
+    FrameResult f = measure_frame(p, n, t);
+    res.added += f.is_new;
     res.failed += !f.pass;
     res.frames.push_back(std::move(f));
   }
+  return res;
+}
 
-  res.out_dir = !r.out_dir.empty() ? r.out_dir : fs::weakly_canonical(actual, ec).parent_path() / "compare";
+fs::path report_dir(const CompareRequest& r, const FramePairs& p) {
+  std::error_code ec;
+  const fs::path out = !r.out_dir.empty() ? r.out_dir : fs::weakly_canonical(p.actual, ec).parent_path() / "compare";
   // Diff images among the frames would be paired as frames next time.
-  for (const fs::path& d : {actual, reference})
-    if (fs::weakly_canonical(res.out_dir, ec) == fs::weakly_canonical(d, ec))
-      throw InputError(res.out_dir.string() + ": reports cannot go into a frames directory (choose another --out)");
-  ensure_directory(res.out_dir);
-  remove_old_diffs(res.out_dir);
+  for (const fs::path& d : {p.actual, p.reference})
+    if (fs::weakly_canonical(out, ec) == fs::weakly_canonical(d, ec))
+      throw InputError(out.string() + ": reports cannot go into a frames directory (choose another --out)");
+  return out;
+}
+
+void write_diff_images(const FramePairs& p, const CompareThresholds& t, CompareResult& res) {
   for (auto& f : res.frames) {
     if (f.pass) continue;
-    const Image a = read_png(actual / f.name), b = read_png(reference / f.name);
+    const Image a = read_png(p.actual / f.name), b = read_png(p.reference / f.name);
     const std::string stem = fs::path(f.name).stem().string();
     f.diff = stem + "_diff.png";
     f.side = stem + "_side.png";
@@ -161,14 +191,29 @@ CompareResult compare_frames(const CompareRequest& r) {
     write_png(res.out_dir / f.diff, heat);
     write_png(res.out_dir / f.side, side_by_side(b, a, heat));
   }
-  if (r.update) {
-    ensure_directory(reference);
-    for (const auto& f : res.frames) {
-      if (!f.is_new && f.metrics.max_abs == 0) continue;  // the same pixels already
-      write_file_atomic(reference / f.name, read_bytes(actual / f.name));
-      ++res.updated;
-    }
+}
+
+void update_reference(const FramePairs& p, CompareResult& res) {
+  ensure_directory(p.reference);
+  for (const auto& f : res.frames) {
+    if (!f.is_new && f.metrics.max_abs == 0) continue;  // the same pixels already
+    write_file_atomic(p.reference / f.name, read_bytes(p.actual / f.name));
+    ++res.updated;
   }
+}
+
+}  // namespace
+
+CompareResult compare_frames(const CompareRequest& r) {
+  check_thresholds(r.thresholds);
+  const FramePairs p = find_frame_pairs(r);
+  check_frames_paired(p, r.update);
+  CompareResult res = measure_frames(p, r.thresholds);
+  res.out_dir = report_dir(r, p);
+  ensure_directory(res.out_dir);
+  remove_old_diffs(res.out_dir);
+  write_diff_images(p, r.thresholds, res);
+  if (r.update) update_reference(p, res);
   res.json = res.out_dir / "compare.json";
   res.junit = res.out_dir / "junit.xml";
   write_file_atomic(res.json, compare_json(r, res));

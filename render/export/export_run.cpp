@@ -180,74 +180,94 @@ std::vector<std::string> export_format_names() {
   return names;
 }
 
-std::vector<fs::path> export_run(const ExportRequest& r) {
-  const Format* format = nullptr;
+namespace {
+
+const Format& find_format(const std::string& name) {
   for (const auto& f : kFormats)
-    if (r.format == f.name) format = &f;
-  if (!format) {
-    std::string names;
-    for (const auto& n : export_format_names()) names += (names.empty() ? "" : ", ") + n;
-    throw InputError("unknown export format \"" + r.format + "\" (expected one of: " + names + ")");
-  }
-  const RunData run = load_run(r.run_dir);
+    if (name == f.name) return f;
+  std::string names;
+  for (const auto& n : export_format_names()) names += (names.empty() ? "" : ", ") + n;
+  throw InputError("unknown export format \"" + name + "\" (expected one of: " + names + ")");
+}
+
+// The end of the frame range (one past the last frame), after checking the range against the run.
+int checked_frame_end(const ExportRequest& r, const RunData& run) {
   const int F = run.trajectory.frames();
   const int begin = r.frame_begin, end = r.frame_end < 0 ? F : r.frame_end;
   if (begin < 0 || begin >= F || end <= begin || end > F)
     throw InputError("frames " + std::to_string(begin) + ":" + std::to_string(r.frame_end) + " out of range: " +
                      r.run_dir.string() + " has frames 0.." + std::to_string(F - 1) + " (A:B exports A..B-1)");
-  Assimp::Exporter exporter;
-  auto* io = new CheckedIOSystem;  // the exporter owns it
-  exporter.SetIOHandler(io);
-  if (format->layout == Layout::kPerFrame) {
-    bool available = false;
-    for (size_t k = 0; k < exporter.GetExportFormatCount(); ++k)
-      available = available || std::string(exporter.GetExportFormatDescription(k)->id) == format->assimp_id;
-    if (!available) throw InputError(std::string("this assimp has no \"") + format->assimp_id + "\" exporter");
-  }
+  return end;
+}
 
-  const DirLock lock(r.run_dir, DirLock::Mode::kShared);  // no optimisation replaces the run meanwhile
-  const fs::path dir = r.run_dir / "export";
-  const fs::path partial = dir / (".partial_" + std::to_string(::getpid()));
-  std::error_code ec;
-  fs::remove_all(partial, ec);
-  ensure_directory(partial);
-  const Bounds bounds = scene_bounds(run.scene, run.trajectory, run.meshes ? &*run.meshes : nullptr);
+void check_exporter_available(const Assimp::Exporter& exporter, const Format& format) {
+  if (format.layout != Layout::kPerFrame) return;
+  bool available = false;
+  for (size_t k = 0; k < exporter.GetExportFormatCount(); ++k)
+    available = available || std::string(exporter.GetExportFormatDescription(k)->id) == format.assimp_id;
+  if (!available) throw InputError(std::string("this assimp has no \"") + format.assimp_id + "\" exporter");
+}
+
+// What one export writes and where: files go to `partial` and are named after `dir` in messages.
+struct ExportJob {
+  const Format& format;
+  const RunData& run;
+  int begin, end;
+  fs::path dir, partial;
+  Bounds bounds;
   FrameGeometry g;
+};
+
+void write_per_frame(ExportJob& job, Assimp::Exporter& exporter, const CheckedIOSystem& io) {
   char name[64];
+  for (int f = job.begin; f < job.end; ++f) {
+    std::snprintf(name, sizeof name, "frame_%04d", f);
+    const std::string file = name + std::string(job.format.extension);
+    if (exporter.Export(make_scene(frame_meshes(job.run, f, job.bounds, job.g)).get(), job.format.assimp_id,
+                        (job.partial / file).string()) != aiReturn_SUCCESS)
+      throw OutputError((job.dir / file).string() + ": export failed (" + exporter.GetErrorString() + ")");
+    if (!io.first_error().empty()) throw OutputError(io.first_error());
+    if (std::error_code missing; !fs::is_regular_file(job.partial / file, missing))
+      throw OutputError((job.dir / file).string() + ": export failed (assimp wrote no file)");
+  }
+}
+
+void write_moving(ExportJob& job, const fs::path& run_dir) {
+  const std::vector<MovingMesh> objects = moving_meshes(run_dir, job.run, job.begin, job.end, job.bounds, job.g);
+  const std::string& scene = job.run.scene.name;
+  if (job.format.layout == Layout::kAnimatedGltf) {
+    write_animated_gltf(job.partial / (scene + ".gltf"), job.partial / (scene + ".bin"), objects,
+                        job.run.scene.time.fps);
+    return;
+  }
+  for (const MovingMesh& m : objects) {
+    write_rest_obj(job.partial / (m.name + ".obj"), m);
+    write_pc2(job.partial / (m.name + ".pc2"), m, job.begin);
+  }
+}
+
+// Writes every file into the partial folder, or removes it and rethrows (naming the export folder).
+void write_partial(ExportJob& job, Assimp::Exporter& exporter, const CheckedIOSystem& io, const fs::path& run_dir) {
+  std::error_code ec;
   try {
-    if (format->layout == Layout::kPerFrame) {
-      for (int f = begin; f < end; ++f) {
-        std::snprintf(name, sizeof name, "frame_%04d", f);
-        const std::string file = name + std::string(format->extension);
-        if (exporter.Export(make_scene(frame_meshes(run, f, bounds, g)).get(), format->assimp_id,
-                            (partial / file).string()) != aiReturn_SUCCESS)
-          throw OutputError((dir / file).string() + ": export failed (" + exporter.GetErrorString() + ")");
-        if (!io->first_error().empty()) throw OutputError(io->first_error());
-        if (std::error_code missing; !fs::is_regular_file(partial / file, missing))
-          throw OutputError((dir / file).string() + ": export failed (assimp wrote no file)");
-      }
-    } else {
-      const std::vector<MovingMesh> objects = moving_meshes(r.run_dir, run, begin, end, bounds, g);
-      if (format->layout == Layout::kAnimatedGltf) {
-        write_animated_gltf(partial / (run.scene.name + ".gltf"), partial / (run.scene.name + ".bin"), objects,
-                            run.scene.time.fps);
-      } else {
-        for (const MovingMesh& m : objects) {
-          write_rest_obj(partial / (m.name + ".obj"), m);
-          write_pc2(partial / (m.name + ".pc2"), m, begin);
-        }
-      }
-    }
+    if (job.format.layout == Layout::kPerFrame)
+      write_per_frame(job, exporter, io);
+    else
+      write_moving(job, run_dir);
   } catch (const OutputError& e) {
-    fs::remove_all(partial, ec);
+    fs::remove_all(job.partial, ec);
     std::string message = e.what();  // name the export folder, not its hidden partial copy
-    if (message.rfind(partial.string(), 0) == 0) message.replace(0, partial.string().size(), dir.string());
+    if (message.rfind(job.partial.string(), 0) == 0) message.replace(0, job.partial.string().size(), job.dir.string());
     throw OutputError(message);
   } catch (...) {
-    fs::remove_all(partial, ec);
+    fs::remove_all(job.partial, ec);
     throw;
   }
-  // Every file was written: only now do they replace what an earlier export left.
+}
+
+// Every file was written: only now do they replace what an earlier export left.
+std::vector<fs::path> move_into_place(const fs::path& partial, const fs::path& dir) {
+  std::error_code ec;
   std::vector<fs::path> written;
   for (const auto& e : fs::directory_iterator(partial)) {
     const fs::path target = dir / e.path().filename();
@@ -258,6 +278,29 @@ std::vector<fs::path> export_run(const ExportRequest& r) {
   fs::remove_all(partial, ec);
   std::sort(written.begin(), written.end());
   return written;
+}
+
+}  // namespace
+
+std::vector<fs::path> export_run(const ExportRequest& r) {
+  const Format& format = find_format(r.format);
+  const RunData run = load_run(r.run_dir);
+  const int end = checked_frame_end(r, run);
+  Assimp::Exporter exporter;
+  auto* io = new CheckedIOSystem;  // the exporter owns it
+  exporter.SetIOHandler(io);
+  check_exporter_available(exporter, format);
+
+  const DirLock lock(r.run_dir, DirLock::Mode::kShared);  // no optimisation replaces the run meanwhile
+  const fs::path dir = r.run_dir / "export";
+  const fs::path partial = dir / (".partial_" + std::to_string(::getpid()));
+  std::error_code ec;
+  fs::remove_all(partial, ec);
+  ensure_directory(partial);
+  ExportJob job{format, run, r.frame_begin, end, dir, partial,
+                scene_bounds(run.scene, run.trajectory, run.meshes ? &*run.meshes : nullptr), {}};
+  write_partial(job, exporter, *io, r.run_dir);
+  return move_into_place(partial, dir);
 }
 
 }  // namespace kf::render

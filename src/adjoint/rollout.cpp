@@ -69,7 +69,12 @@ bool simulate(System& sys, const VecX& x0, const VecX& v0, int N, const StepCont
   }
   r.context.resize(every > 0 ? (N + every - 1) / every + 1 : 0);
   // Checkpointed: steps record into one scratch entry; the backward pass records its segments again.
-  ensure_tape(sys, r.tape, every > 0 ? 1 : N);
+  // Without a tape the entries already there are kept (the next evaluation with a gradient reuses them)
+  // but none is added.
+  const bool one_entry = every > 0 || !options.tape;
+  if (every > 0) ensure_tape(sys, r.tape, 1);
+  else if (!options.tape) ensure_tape(sys, r.tape, std::clamp(int(r.tape.size()), 1, std::max(N, 1)));
+  else ensure_tape(sys, r.tape, N);
   r.x[0] = x0;
   r.v[0] = v0;
   // States not kept alternate between two scratch pairs so a step never reads what it writes.
@@ -84,7 +89,7 @@ bool simulate(System& sys, const VecX& x0, const VecX& v0, int N, const StepCont
     if (every > 0 && n % every == 0) sys.save_step_context(n, r.context[n / every]);
     VecX& xn = r.kept(n + 1) ? r.x[n + 1] : scratch_x[n & 1];
     VecX& vn = r.kept(n + 1) ? r.v[n + 1] : scratch_v[n & 1];
-    StepRecord& record = *r.tape[every > 0 ? 0 : n];
+    StepRecord& record = *r.tape[one_entry ? 0 : n];
     if (!sys.step(n, *xc, *vc, u(n), xn, vn, record)) {
       r.diverged_at = n;
       return false;

@@ -59,6 +59,9 @@ struct RolloutOptions {
   // Bytes the rollout's states and tape may hold (0: no limit). With checkpoint_every = 0, a rollout
   // whose estimate (adjoint/memory_estimate.h) passes it is checkpointed at the spacing that needs least.
   std::size_t memory_budget = 0;
+  // false: no tape is kept (an evaluation without a gradient; backward cannot follow): every step records
+  // into the first entry, so such a run holds one entry however many steps it has.
+  bool tape = true;
 };
 
 // Runs N steps from (x0, v0) under the controls. Returns false (and sets diverged_at) when a step

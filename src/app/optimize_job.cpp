@@ -206,12 +206,12 @@ struct JobResult {
   Diagnosis diagnosis;
 };
 
-// The rollout budget of a problem within a run's budget (bytes): what the optimiser's vectors leave, and the
-// line that says whether checkpointing is on. At least 1 byte, so a run over budget checkpoints as tightly as
-// it can.
-std::size_t rollout_budget(const Problem& problem, System& sys, int lbfgs_memory, std::size_t budget, int& every,
-                           std::string& line) {
-  const std::size_t fixed = optimizer_bytes(std::size_t(problem.size()), lbfgs_memory);
+// The rollout budget of a problem within a run's budget (bytes): what the optimiser's vectors and `held` (the
+// job's other memory) leave, and the line that says whether checkpointing is on. At least 1 byte, so a run
+// over budget checkpoints as tightly as it can.
+std::size_t rollout_budget(const Problem& problem, System& sys, int lbfgs_memory, std::size_t held,
+                           std::size_t budget, int& every, std::string& line) {
+  const std::size_t fixed = optimizer_bytes(std::size_t(problem.size()), lbfgs_memory) + held;
   const std::size_t left = budget > fixed ? budget - fixed : 1;
   int costed = 0;
   for (int n = 0; n <= problem.time().steps(); ++n) costed += problem.active(n);
@@ -229,24 +229,29 @@ std::size_t rollout_budget(const Problem& problem, System& sys, int lbfgs_memory
   return left;
 }
 
-// Simulates the best point (and, for a cape blend, the uncontrolled run its end state is measured
-// against), then writes controls.bin, trajectory.bin, meshes.bin, iterations.csv, convergence.png and
-// report.json into dir.
-nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, size_t stages, bool resuming,
-                                JobResult& job, const EvaluationLog& elog) {
+// The uncontrolled run (the initial guess: no force, the scene's own initial velocities): the keyframes'
+// errors before, and for a cape blend the end state it is measured against.
+struct UncontrolledRun {
+  double keyframes = 0;  // the keyframe terms of φ (all of φ if it diverged)
+  Trajectory frames;
+  nlohmann::json stats;
+  nlohmann::json measures;
+};
+
+UncontrolledRun run_uncontrolled(const Scene& scene, JobResult& job) {
   Problem& problem = *job.problem;
-  System& sys = *job.sys;
-  // The uncontrolled run (the initial guess: no force, the scene's own initial velocities): the keyframes'
-  // errors before, and for a cape blend the end state it is measured against.
-  nlohmann::json uncontrolled_stats;
-  const double uncontrolled_objective = problem.evaluate(problem.initial_guess(), nullptr);
-  const bool uncontrolled_diverged = problem.last_diverged();
-  const double uncontrolled_keyframes = uncontrolled_diverged ? uncontrolled_objective : keyframe_terms(problem.breakdown());
-  const Trajectory uncontrolled = frames_of(problem.rollout(), job.time, sys.particles());
-  for (const auto& [name, value] : sys.run_stats()) uncontrolled_stats[name] = value;
-  const nlohmann::json measures_before = figure_measures(scene, uncontrolled);
-  const double final_objective = problem.evaluate(job.z, nullptr);
-  const Trajectory frames = frames_of(problem.rollout(), job.time, sys.particles());
+  UncontrolledRun u;
+  const double objective = problem.evaluate(problem.initial_guess(), nullptr);
+  u.keyframes = problem.last_diverged() ? objective : keyframe_terms(problem.breakdown());
+  u.frames = frames_of(problem.rollout(), job.time, job.sys->particles());
+  for (const auto& [name, value] : job.sys->run_stats()) u.stats[name] = value;
+  u.measures = figure_measures(scene, u.frames);
+  return u;
+}
+
+// controls.bin, evaluations.bin (when kept), trajectory.bin, meshes.bin, iterations.csv and convergence.png.
+void write_run_files(const fs::path& dir, const Scene& scene, const JobResult& job, const Trajectory& frames,
+                     const EvaluationLog& elog) {
   save_controls(dir / "controls.bin", job.z, job.time.substeps);
   std::error_code ec;
   if (job.tape.complete()) save_evaluations(dir / "evaluations.bin", job.tape.records());
@@ -258,184 +263,224 @@ nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, size_t 
     write_history_csv(dir / "iterations.csv", history, history.front().rec.terms);
     plot_csv(dir / "iterations.csv", dir / "convergence.png", scene.name + ": objective and gradient norm", 1, {3, 4});
   }
-  nlohmann::json report = {{"scene", scene.name},
-                           {"command", "optimize"},
-                           {"system", sys.describe()},
-                           {"controls", problem.controls().kind()},
-                           {"control_variables", problem.size()},
-                           {"steps", job.time.steps()},
-                           {"substeps", job.time.substeps},
-                           {"checkpoint_every", problem.checkpoint_every()},
-                           {"memory_budget_gb", job.memory_budget_gb},
-                           {"checkpoint_every_for_budget", job.auto_checkpoint_every},
-                           {"adjoint", scene.optimizer.adjoint},
-                           {"stages", stages},
-                           {"resumed", resuming},
-                           {"replayed_evaluations", job.tape.replayed()},
-                           {"status", job.status},
-                           {"interrupted", job.interrupted},
-                           {"evaluations", job.evaluations},
-                           {"wall_seconds", job.seconds},
-                           {"initial_objective", history.empty() ? 0.0 : history.front().rec.phi},
-                           {"final_objective", final_objective},
-                           {"measures", figure_measures(scene, frames)}};
-  nlohmann::json terms = nlohmann::json::object();
-  for (const auto& [name, value] : problem.breakdown()) terms[name] = value;
-  report["final_terms"] = terms;
+}
+
+nlohmann::json report_summary(const Scene& scene, size_t stages, bool resuming, const JobResult& job,
+                              const EvaluationLog& elog, double final_objective, const Trajectory& frames) {
+  const Problem& problem = *job.problem;
+  const auto& history = elog.history();
+  return {{"scene", scene.name},
+          {"command", "optimize"},
+          {"system", job.sys->describe()},
+          {"controls", problem.controls().kind()},
+          {"control_variables", problem.size()},
+          {"steps", job.time.steps()},
+          {"substeps", job.time.substeps},
+          {"checkpoint_every", problem.checkpoint_every()},
+          {"memory_budget_gb", job.memory_budget_gb},
+          {"checkpoint_every_for_budget", job.auto_checkpoint_every},
+          {"adjoint", scene.optimizer.adjoint},
+          {"stages", stages},
+          {"resumed", resuming},
+          {"replayed_evaluations", job.tape.replayed()},
+          {"status", job.status},
+          {"interrupted", job.interrupted},
+          {"evaluations", job.evaluations},
+          {"wall_seconds", job.seconds},
+          {"initial_objective", history.empty() ? 0.0 : history.front().rec.phi},
+          {"final_objective", final_objective},
+          {"measures", figure_measures(scene, frames)}};
+}
+
+// Whether the keyframes were reached and, if not, why (opt/diagnosis.h), into job.diagnosis and the report.
+void diagnose_run(const Scene& scene, JobResult& job, const EvaluationLog& elog, const UncontrolledRun& before,
+                  double final_objective, nlohmann::json& report) {
+  const Problem& problem = *job.problem;
   double effort_end = 0;
   for (const auto& [name, value] : problem.breakdown())
     if (name == "effort") effort_end = value;
   const double final_keyframes = problem.last_diverged() ? final_objective : keyframe_terms(problem.breakdown());
-
-  // Whether the keyframes were reached and, if not, why (opt/diagnosis.h).
-  const std::vector<KeyframeJudgement> keyframes = judge_keyframes(scene, measures_before, report["measures"]);
+  const std::vector<KeyframeJudgement> keyframes = judge_keyframes(scene, before.measures, report["measures"]);
   const Sensitivity sensitivity = measure_sensitivity(scene, job.time);
   RunFacts facts = run_facts(job.status, elog.history());
-  facts.keyframe_objective_start = uncontrolled_keyframes;
+  facts.keyframe_objective_start = before.keyframes;
   facts.keyframe_objective_end = final_keyframes;
   facts.effort_end = effort_end;
   job.diagnosis = diagnose(keyframes, sensitivity, facts);
   report["diagnosis"] = job.diagnosis.to_json();
-  report["diagnosis"]["keyframe_objective_start"] = uncontrolled_keyframes;
+  report["diagnosis"]["keyframe_objective_start"] = before.keyframes;
   report["diagnosis"]["keyframe_objective_end"] = final_keyframes;
   report["diagnosis"]["budget_reached"] = facts.budget;
   report["diagnosis"]["max_objective_evaluated"] = facts.max_objective;
   report["keyframe_errors"] = nlohmann::json::array();
   for (const auto& k : keyframes) report["keyframe_errors"].push_back(k.to_json());
   report["sensitivity"] = sensitivity.to_json();
+}
+
+// Simulates the best point (and, for a cape blend, the uncontrolled run its end state is measured
+// against), then writes controls.bin, trajectory.bin, meshes.bin, iterations.csv, convergence.png and
+// report.json into dir.
+nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, size_t stages, bool resuming,
+                                JobResult& job, const EvaluationLog& elog) {
+  Problem& problem = *job.problem;
+  const UncontrolledRun uncontrolled = run_uncontrolled(scene, job);
+  const double final_objective = problem.evaluate(job.z, nullptr);
+  const Trajectory frames = frames_of(problem.rollout(), job.time, job.sys->particles());
+  write_run_files(dir, scene, job, frames, elog);
+  nlohmann::json report = report_summary(scene, stages, resuming, job, elog, final_objective, frames);
+  nlohmann::json terms = nlohmann::json::object();
+  for (const auto& [name, value] : problem.breakdown()) terms[name] = value;
+  report["final_terms"] = terms;
+  diagnose_run(scene, job, elog, uncontrolled, final_objective, report);
   report["stage_results"] = nlohmann::json::array();
   for (const auto& st : job.stages) report["stage_results"].push_back(st.to_json());
-  for (const auto& [name, value] : sys.run_stats()) report["run_stats"][name] = value;
+  for (const auto& [name, value] : job.sys->run_stats()) report["run_stats"][name] = value;
   if (scene.character) {
-    report["uncontrolled_run_stats"] = uncontrolled_stats;
-    report["cape_end_state"] = cape_end_state(scene, frames, uncontrolled);
+    report["uncontrolled_run_stats"] = uncontrolled.stats;
+    report["cape_end_state"] = cape_end_state(scene, frames, uncontrolled.frames);
   }
   write_json(dir / "report.json", report);
   return report;
 }
 
-}  // namespace
-
-OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& opt) {
-  const bool resuming = !opt.resume.empty();
-  Scene scene = resuming ? load_run_scene(opt.resume) : load_scene(scene_file);
+// The scene of a new run or of the run being resumed, with the command line's overrides.
+Scene job_scene(const fs::path& scene_file, const OptimizeOptions& opt) {
+  Scene scene = !opt.resume.empty() ? load_run_scene(opt.resume) : load_scene(scene_file);
   if (!opt.adjoint.empty()) scene.optimizer.adjoint = opt.adjoint;
   if (opt.max_seconds >= 0) scene.optimizer.max_seconds = opt.max_seconds;
   for (const std::string& w : unreachable_keyframes(scene)) warn(w);
-  const fs::path dir = resuming ? fs::path(opt.resume) : run_dir_for(scene, opt.out);
+  return scene;
+}
 
-  // A run that cannot fit in the machine's memory even at the checkpoint spacing that needs least (the
-  // memory budget below picks its spacing itself unless --checkpoint-every sets one) is refused before the
-  // stages are planned: planning a sensitive cloth simulates it once.
-  const auto least_memory = [&](int substeps) {
-    const int every = opt.checkpoint_every > 0
-                          ? opt.checkpoint_every
-                          : std::max(1, int(std::sqrt(double(scene.time.frames) * substeps)));
-    return optimize_memory(scene, substeps, every);
-  };
-  // --max-memory, as simulate reads it (0 or absent: the scene's optimizer.max_memory, else half the machine's).
-  const std::uint64_t max_memory = opt.max_memory.empty() ? 0 : parse_memory_size(opt.max_memory);
-  check_memory(scene, least_memory(scene.time.substeps), 0);
-  // The stages of coarse-to-fine continuation; a resumed run continues in the last stage.
-  const StagePlan plan = plan_stages(scene);
-  std::vector<StageSpec> stages = plan.stages;
-  if (opt.max_evaluations >= 0)
-    for (auto& s : stages) s.max_evaluations = opt.max_evaluations;
-  JobResult job;
-  TimeSpec z_time = scene.time;
-  // A run that kept its evaluations resumes by replaying them from the start (the same path, budget and
-  // result as if it had not stopped); an older one continues its last stage from controls.bin.
-  const bool replaying = resuming && fs::exists(dir / "evaluations.bin");
-  if (replaying) {
+// The memory a run needs at the checkpoint spacing that needs least: --checkpoint-every when given, else
+// sqrt of the steps (the memory budget picks the spacing itself otherwise).
+RunMemory least_memory(const Scene& scene, const OptimizeOptions& opt, int substeps) {
+  const int every = opt.checkpoint_every > 0 ? opt.checkpoint_every
+                                             : std::max(1, int(std::sqrt(double(scene.time.frames) * substeps)));
+  return optimize_memory(scene, substeps, every);
+}
+
+// A run that cannot fit in the machine's memory at its most demanding stage is refused.
+void check_stages_memory(const Scene& scene, const OptimizeOptions& opt, const std::vector<StageSpec>& stages) {
+  RunMemory need;
+  for (const auto& st : stages) {
+    const RunMemory e = least_memory(scene, opt, st.substeps);
+    if (e.bytes > need.bytes) need = e;
+  }
+  check_memory(scene, need, 0);
+}
+
+// A run that kept its evaluations resumes by replaying them from the start (the same path, budget and
+// result as if it had not stopped); an older one continues its last stage from controls.bin.
+void prepare_resume(const fs::path& dir, JobResult& job, TimeSpec& z_time, std::vector<StageSpec>& stages) {
+  if (fs::exists(dir / "evaluations.bin")) {
     job.tape.set_replay(load_evaluations(dir / "evaluations.bin"));
-  } else if (resuming) {
-    job.z = load_controls(dir / "controls.bin", &z_time.substeps);
-    stages.erase(stages.begin(), stages.end() - 1);
+    return;
   }
-  {
-    RunMemory need;
-    for (const auto& st : stages) {
-      const RunMemory e = least_memory(st.substeps);
-      if (e.bytes > need.bytes) need = e;
-    }
-    check_memory(scene, need, 0);
-  }
-  // Build the first system before writing anything, so bad scenes leave no trace.
-  TimeSpec& time = job.time;
-  time = scene.time;
-  time.substeps = stages[0].substeps;
-  job.sys = make_system(scene, time.h());
-  // The new run is written beside the old one and swapped in at the end (locked meanwhile), so a failed or
-  // killed job leaves an existing run directory as it was.
-  StagedDir staged(dir);
-  const fs::path work = staged.path();
-  if (resuming) staged.copy_from_target([](const std::string&) { return true; });
-  else naming_run_dir(staged, [&] { prepare_run_dir(work, scene); });
+  job.z = load_controls(dir / "controls.bin", &z_time.substeps);
+  stages.erase(stages.begin(), stages.end() - 1);
+}
 
-  EvaluationLog elog(opt.quiet);
-  if (!plan.why.empty() && !resuming) elog.say(plan.why);
-  SignalGuard signals;
-  for (size_t s = 0; s < stages.size() && !job.interrupted; ++s) {
-    time.substeps = stages[s].substeps;
-    if (s > 0) job.sys = make_system(scene, time.h());
-    Scene stage_scene = scene;  // a stage may optimise a coarser control parameterisation
-    if (stages[s].controls) stage_scene.controls = *stages[s].controls;
-    VecX& z = job.z;
-    // The first frame of the previous stage's forces (a resumed run's controls are the scene's).
-    const int z_from_frame = job.problem ? job.problem->controls().first_frame() : scene.controls.from_frame;
-    VecX v0_before;  // the initial velocities the previous stage's kind gave, when the kind changes
-    if (job.problem && job.problem->controls().kind() != std::string(control_kind_name(stage_scene.controls.kind)))
-      job.problem->controls().initial_velocity(z, v0_before);
-    job.problem = std::make_unique<Problem>(stage_scene, time, *job.sys);
-    Problem& problem = *job.problem;
-    if (opt.checkpoint_every >= 0) problem.set_checkpoint_every(opt.checkpoint_every);
-    const std::size_t budget = max_memory > 0                     ? std::size_t(max_memory)
-                               : scene.optimizer.max_memory > 0 ? std::size_t(scene.optimizer.max_memory * 1e9)
+// What every stage of one job shares.
+struct JobContext {
+  const Scene& scene;
+  const OptimizeOptions& opt;
+  const StagePlan& plan;
+  const fs::path& dir;
+  bool resuming;
+  std::uint64_t max_memory;  // --max-memory in bytes (0: the scene's optimizer.max_memory)
+  std::uint64_t all_evaluations;  // recorded on one tape over all stages
+  EvaluationLog& elog;
+};
+
+// The stage's problem (its controls carried over from the previous stage's, or the initial guess) with its
+// checkpointing and memory budget set; gives the memory line to print.
+std::string set_up_stage(const JobContext& c, const StageSpec& stage, JobResult& job, TimeSpec& z_time) {
+  Scene stage_scene = c.scene;  // a stage may optimise a coarser control parameterisation
+  if (stage.controls) stage_scene.controls = *stage.controls;
+  VecX& z = job.z;
+  // The first frame of the previous stage's forces (a resumed run's controls are the scene's).
+  const int z_from_frame = job.problem ? job.problem->controls().first_frame() : c.scene.controls.from_frame;
+  VecX v0_before;  // the initial velocities the previous stage's kind gave, when the kind changes
+  if (job.problem && job.problem->controls().kind() != std::string(control_kind_name(stage_scene.controls.kind)))
+    job.problem->controls().initial_velocity(z, v0_before);
+  job.problem = std::make_unique<Problem>(stage_scene, job.time, *job.sys);
+  Problem& problem = *job.problem;
+  if (c.opt.checkpoint_every >= 0) problem.set_checkpoint_every(c.opt.checkpoint_every);
+  const std::size_t budget = c.max_memory > 0                      ? std::size_t(c.max_memory)
+                             : c.scene.optimizer.max_memory > 0 ? std::size_t(c.scene.optimizer.max_memory * 1e9)
                                                                 : default_memory_budget();
-    job.memory_budget_gb = budget / 1e9;
-    std::string memory_line;
-    problem.set_memory_budget(rollout_budget(problem, *job.sys, scene.optimizer.memory, budget,
-                                             job.auto_checkpoint_every, memory_line));
-    if (problem.checkpoint_every() > 0) job.auto_checkpoint_every = 0;
-    if (z.size() == 0) z = problem.initial_guess();
-    else if (v0_before.size()) z = problem.controls().from_initial_velocity(v0_before);
-    else z = problem.controls().remap_from(z, z_time, z_from_frame);
-    if (z.size() != problem.size())
-      throw InputError((dir / "controls.bin").string() + ": holds " + std::to_string(z.size()) +
-                       " controls, the scene needs " + std::to_string(problem.size()));
-    z_time = time;
-    const int stage_id = stages.size() > 1 ? int(s) + 1 : 0;
-    elog.say(std::string(resuming ? "resuming " : "optimising ") + scene.name +
+  job.memory_budget_gb = budget / 1e9;
+  std::string memory_line;
+  // Besides the optimiser and the rollout: the recorded evaluations (points and gradients, for a resume)
+  // and, at the end, the run directory's two trajectories (the uncontrolled run and the result).
+  const std::size_t held =
+      job.tape.bytes_for(std::uint64_t(problem.size()), c.all_evaluations) +
+      2 * std::size_t(c.scene.time.frames + 1) * 2 * std::size_t(job.sys->dof()) * sizeof(double);
+  problem.set_memory_budget(rollout_budget(problem, *job.sys, c.scene.optimizer.memory, held, budget,
+                                           job.auto_checkpoint_every, memory_line));
+  if (problem.checkpoint_every() > 0) job.auto_checkpoint_every = 0;
+  if (z.size() == 0) z = problem.initial_guess();
+  else if (v0_before.size()) z = problem.controls().from_initial_velocity(v0_before);
+  else z = problem.controls().remap_from(z, z_time, z_from_frame);
+  if (z.size() != problem.size())
+    throw InputError((c.dir / "controls.bin").string() + ": holds " + std::to_string(z.size()) +
+                     " controls, the scene needs " + std::to_string(problem.size()));
+  z_time = job.time;
+  return memory_line;
+}
+
+void say_stage(const JobContext& c, const JobResult& job, int stage_id) {
+  const Problem& problem = *job.problem;
+  const TimeSpec& time = job.time;
+  c.elog.say(std::string(c.resuming ? "resuming " : "optimising ") + c.scene.name +
              (stage_id ? " stage " + std::to_string(stage_id) : "") + ": " + job.sys->describe() + ", " +
              std::to_string(time.steps()) + " steps (h = " + std::to_string(time.h()) + " s), " +
              std::to_string(problem.size()) + " control variables (" + problem.controls().kind() +
              (problem.controls().first_frame() > 0 ? " from frame " + std::to_string(problem.controls().first_frame()) : "") +
              ")");
-    if (problem.checkpoint_every() == 0) elog.say(memory_line);
-    OptimizerSpec spec = scene.optimizer;
-    spec.max_evaluations = stages[s].max_evaluations;
-    if (spec.first_step < 0) spec.first_step = plan.scaled_first_step ? problem.control_scale() : 0;
-    Progress progress("optimize " + scene.name, spec.max_evaluations);
-    const OptimizeResult res = run_stage(problem, spec, scene.optimizer.restarts, z, stage_id, time.substeps,
-                                         job.seconds, elog, progress, job.tape);
-    progress.finish();
-    z = res.z;
-    StageResult st;
-    st.kind = problem.controls().kind();
-    st.substeps = time.substeps;
-    st.evaluations = res.evaluations;
-    st.objective_start = res.history.empty() ? res.phi : res.history.front().phi;
-    st.objective_end = res.phi;
-    st.status = res.status;
-    job.stages.push_back(st);
-    job.seconds += res.seconds;
-    job.evaluations += res.evaluations;
-    job.status = res.status;
-    job.interrupted = res.interrupted;
-  }
+}
 
-  nlohmann::json report;
-  naming_run_dir(staged, [&] { report = write_run_report(work, scene, stages.size(), resuming, job, elog); });
+void record_stage(const OptimizeResult& res, JobResult& job) {
+  job.z = res.z;
+  StageResult st;
+  st.kind = job.problem->controls().kind();
+  st.substeps = job.time.substeps;
+  st.evaluations = res.evaluations;
+  st.objective_start = res.history.empty() ? res.phi : res.history.front().phi;
+  st.objective_end = res.phi;
+  st.status = res.status;
+  job.stages.push_back(st);
+  job.seconds += res.seconds;
+  job.evaluations += res.evaluations;
+  job.status = res.status;
+  job.interrupted = res.interrupted;
+}
+
+// Stage s of the coarse-to-fine continuation: its system (the first is built already), problem and optimisation.
+void run_job_stage(const JobContext& c, const std::vector<StageSpec>& stages, size_t s, JobResult& job,
+                   TimeSpec& z_time) {
+  job.time.substeps = stages[s].substeps;
+  if (s > 0) job.sys = make_system(c.scene, job.time.h());
+  const std::string memory_line = set_up_stage(c, stages[s], job, z_time);
+  Problem& problem = *job.problem;
+  const int stage_id = stages.size() > 1 ? int(s) + 1 : 0;
+  say_stage(c, job, stage_id);
+  if (problem.checkpoint_every() == 0) c.elog.say(memory_line);
+  OptimizerSpec spec = c.scene.optimizer;
+  spec.max_evaluations = stages[s].max_evaluations;
+  if (spec.first_step < 0) spec.first_step = c.plan.scaled_first_step ? problem.control_scale() : 0;
+  Progress progress("optimize " + c.scene.name, spec.max_evaluations);
+  const OptimizeResult res = run_stage(problem, spec, c.scene.optimizer.restarts, job.z, stage_id, job.time.substeps,
+                                       job.seconds, c.elog, progress, job.tape);
+  progress.finish();
+  record_stage(res, job);
+}
+
+// The closing lines: status, objective and the diagnosis (or how to resume), on the log and, when quiet,
+// on standard output.
+void say_outcome(const OptimizeOptions& opt, const fs::path& dir, const JobResult& job, const nlohmann::json& report,
+                 EvaluationLog& elog) {
   std::ostringstream tail;
   tail << job.status << " after " << job.evaluations << " evaluations in " << std::fixed << std::setprecision(2)
        << job.seconds << " s; objective " << std::scientific << report["final_objective"].get<double>();
@@ -446,6 +491,50 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   else
     elog.say(job.diagnosis.line);
   if (opt.quiet && !job.interrupted && !job.diagnosis.failed()) std::cout << job.diagnosis.line << std::endl;
+}
+
+}  // namespace
+
+OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& opt) {
+  const bool resuming = !opt.resume.empty();
+  const Scene scene = job_scene(scene_file, opt);
+  const fs::path dir = resuming ? fs::path(opt.resume) : run_dir_for(scene, opt.out);
+  // A run that cannot fit in the machine's memory even at the checkpoint spacing that needs least is refused
+  // before the stages are planned: planning a sensitive cloth simulates it once.
+  // --max-memory, as simulate reads it (0 or absent: the scene's optimizer.max_memory, else half the machine's).
+  const std::uint64_t max_memory = opt.max_memory.empty() ? 0 : parse_memory_size(opt.max_memory);
+  check_memory(scene, least_memory(scene, opt, scene.time.substeps), 0);
+  // The stages of coarse-to-fine continuation; a resumed run continues in the last stage.
+  const StagePlan plan = plan_stages(scene);
+  std::vector<StageSpec> stages = plan.stages;
+  if (opt.max_evaluations >= 0)
+    for (auto& s : stages) s.max_evaluations = opt.max_evaluations;
+  JobResult job;
+  TimeSpec z_time = scene.time;
+  if (resuming) prepare_resume(dir, job, z_time, stages);
+  check_stages_memory(scene, opt, stages);
+  // Build the first system before writing anything, so bad scenes leave no trace.
+  job.time = scene.time;
+  job.time.substeps = stages[0].substeps;
+  job.sys = make_system(scene, job.time.h());
+  // The new run is written beside the old one and swapped in at the end (locked meanwhile), so a failed or
+  // killed job leaves an existing run directory as it was.
+  StagedDir staged(dir);
+  const fs::path work = staged.path();
+  if (resuming) staged.copy_from_target([](const std::string&) { return true; });
+  else naming_run_dir(staged, [&] { prepare_run_dir(work, scene); });
+
+  std::uint64_t all_evaluations = 0;
+  for (const auto& st : stages) all_evaluations += std::uint64_t(std::max(st.max_evaluations, 1));
+  EvaluationLog elog(opt.quiet);
+  if (!plan.why.empty() && !resuming) elog.say(plan.why);
+  SignalGuard signals;
+  const JobContext context{scene, opt, plan, dir, resuming, max_memory, all_evaluations, elog};
+  for (size_t s = 0; s < stages.size() && !job.interrupted; ++s) run_job_stage(context, stages, s, job, z_time);
+
+  nlohmann::json report;
+  naming_run_dir(staged, [&] { report = write_run_report(work, scene, stages.size(), resuming, job, elog); });
+  say_outcome(opt, dir, job, report, elog);
   commit_run_dir(staged, [&](const fs::path& w) {
     write_file_atomic(w / (resuming ? "log_resumed.txt" : "log.txt"), elog.text());
   });

@@ -69,6 +69,84 @@ ChildRun run_child(const std::vector<std::string>& args) {
   return r;
 }
 
+// One size of the sweep: its optimisation run in a fresh process, and the report it wrote.
+struct CrowdPoint {
+  int agents = 0;
+  double max_gb = 0;  // 0: no memory budget
+  ChildRun child;
+  nlohmann::json report;
+};
+
+CrowdPoint run_crowd_point(const nlohmann::json& base, int agents, double max_gb, int evaluations,
+                           const std::filesystem::path& work, const std::filesystem::path& self) {
+  const std::string name = "square-" + std::to_string(agents) + (max_gb > 0 ? "-budget" : "");
+  const auto scene = work / (name + ".json");
+  write_file_atomic(scene, scaled_scene(base, agents).dump(1) + "\n");
+  const auto run = work / name;
+  std::cerr << "bench crowd: " << agents << " agents" << (max_gb > 0 ? ", budget " + fmt(max_gb) + " GB" : "")
+            << std::endl;
+  std::vector<std::string> args = {self.string(), "optimize", scene.string(), "--out", run.string(),
+                                   "--max-evaluations", std::to_string(evaluations), "--quiet"};
+  if (max_gb > 0) {
+    args.push_back("--max-memory");
+    args.push_back(std::to_string(std::llround(max_gb * 1e9)));  // bytes
+  }
+  CrowdPoint p{agents, max_gb, run_child(args), {}};
+  std::ifstream rin(run / "report.json");
+  if (!rin) throw OutputError("bench crowd: " + name + " wrote no report (exit " + std::to_string(p.child.status) + ")");
+  p.report = nlohmann::json::parse(rin);
+  return p;
+}
+
+CsvTable crowd_table() {
+  return CsvTable({"agents", "control_variables", "steps", "max_memory_gb", "checkpoint_every", "evaluations",
+                   "optimize_s", "s_per_evaluation", "peak_mb", "bytes_per_agent_step", "inside_first",
+                   "inside_second", "status"});
+}
+
+void add_crowd_row(const CrowdPoint& p, CsvTable& t) {
+  const nlohmann::json& rep = p.report;
+  const int evals = rep["evaluations"], steps = rep["steps"];
+  const double secs = rep["wall_seconds"];
+  const auto& m = rep["measures"];
+  auto inside = [&](size_t k) { return k < m.size() && m[k].contains("inside_fraction") ? fmt(m[k]["inside_fraction"]) : ""; };
+  const double per_agent_step = 1024.0 * double(p.child.peak_kb) / (double(p.agents) * steps);
+  t.add({std::to_string(p.agents), std::to_string(rep["control_variables"].get<long>()), std::to_string(steps),
+         fmt(rep["memory_budget_gb"]), std::to_string(rep["checkpoint_every_for_budget"].get<int>()),
+         std::to_string(evals), fmt(secs), fmt(secs / std::max(evals, 1)), fmt(p.child.peak_kb / 1024.0),
+         fmt(per_agent_step), inside(0), inside(1), std::to_string(p.child.status)});
+}
+
+// Agents, seconds per evaluation and peak MB of the runs without a memory budget, for the fitted exponents.
+struct CrowdFit {
+  std::vector<double> n, te, pk;
+  void add(const CrowdPoint& p) {
+    if (p.max_gb != 0) return;
+    const int evals = p.report["evaluations"];
+    const double secs = p.report["wall_seconds"];
+    n.push_back(p.agents);
+    te.push_back(secs / std::max(evals, 1));
+    pk.push_back(p.child.peak_kb / 1024.0);
+  }
+};
+
+nlohmann::json write_crowd_results(const CsvTable& t, const CrowdFit& fit, const nlohmann::json& points,
+                                   const std::filesystem::path& out) {
+  const auto csv = out / "flock_crowd.csv";
+  t.write(csv);
+  plot_csv(csv, out / "flock_crowd_time.png", "crowd: seconds per evaluation and whole optimisation against agents",
+           t.col("agents"), {t.col("s_per_evaluation"), t.col("optimize_s")}, true, true);
+  plot_csv(csv, out / "flock_crowd_memory.png", "crowd: peak resident MB against agents", t.col("agents"),
+           {t.col("peak_mb")}, true, true);
+  nlohmann::json j = {{"table", t.excerpt()},
+                      {"evaluation_exponent", fitted_exponent(fit.n, fit.te)},
+                      {"memory_exponent", fitted_exponent(fit.n, fit.pk)},
+                      {"points", points}};
+  std::cout << "flock_crowd.csv\n" << t.excerpt() << "fitted exponent: per evaluation " << fmt(j["evaluation_exponent"])
+            << ", peak memory " << fmt(j["memory_exponent"]) << "\n" << std::endl;
+  return j;
+}
+
 }  // namespace
 
 nlohmann::json bench_crowd(const CrowdSweepOptions& o, const std::filesystem::path& out,
@@ -78,60 +156,19 @@ nlohmann::json bench_crowd(const CrowdSweepOptions& o, const std::filesystem::pa
   const nlohmann::json base = nlohmann::json::parse(in);
   const std::filesystem::path work = out / "crowd";
   ensure_directory(work);
-  CsvTable t({"agents", "control_variables", "steps", "max_memory_gb", "checkpoint_every", "evaluations",
-              "optimize_s", "s_per_evaluation", "peak_mb", "bytes_per_agent_step", "inside_first", "inside_second",
-              "status"});
-  std::vector<double> n, te, pk;
+  CsvTable t = crowd_table();
+  CrowdFit fit;
   nlohmann::json points = nlohmann::json::array();
   std::vector<std::pair<int, double>> sizes;
   for (int a : o.agents) sizes.emplace_back(a, 0.0);
   for (int a : o.budget_agents) sizes.emplace_back(a, o.budget_gb);
   for (const auto& [agents, max_gb] : sizes) {
-    const std::string name = "square-" + std::to_string(agents) + (max_gb > 0 ? "-budget" : "");
-    const auto scene = work / (name + ".json");
-    write_file_atomic(scene, scaled_scene(base, agents).dump(1) + "\n");
-    const auto run = work / name;
-    std::cerr << "bench crowd: " << agents << " agents" << (max_gb > 0 ? ", budget " + fmt(max_gb) + " GB" : "")
-              << std::endl;
-    std::vector<std::string> args = {self.string(), "optimize", scene.string(), "--out", run.string(),
-                                     "--max-evaluations", std::to_string(o.evaluations), "--quiet"};
-    if (max_gb > 0) {
-      args.push_back("--max-memory");
-      args.push_back(std::to_string(std::llround(max_gb * 1e9)));  // bytes
-    }
-    const ChildRun c = run_child(args);
-    std::ifstream rin(run / "report.json");
-    if (!rin) throw OutputError("bench crowd: " + name + " wrote no report (exit " + std::to_string(c.status) + ")");
-    const nlohmann::json rep = nlohmann::json::parse(rin);
-    const int evals = rep["evaluations"], steps = rep["steps"];
-    const double secs = rep["wall_seconds"];
-    const auto& m = rep["measures"];
-    auto inside = [&](size_t k) { return k < m.size() && m[k].contains("inside_fraction") ? fmt(m[k]["inside_fraction"]) : ""; };
-    const double per_agent_step = 1024.0 * double(c.peak_kb) / (double(agents) * steps);
-    t.add({std::to_string(agents), std::to_string(rep["control_variables"].get<long>()), std::to_string(steps),
-           fmt(rep["memory_budget_gb"]), std::to_string(rep["checkpoint_every_for_budget"].get<int>()),
-           std::to_string(evals), fmt(secs), fmt(secs / std::max(evals, 1)), fmt(c.peak_kb / 1024.0),
-           fmt(per_agent_step), inside(0), inside(1), std::to_string(c.status)});
-    points.push_back({{"agents", agents}, {"max_memory_gb", max_gb}, {"exit", c.status}, {"report", rep}});
-    if (max_gb == 0) {
-      n.push_back(agents);
-      te.push_back(secs / std::max(evals, 1));
-      pk.push_back(c.peak_kb / 1024.0);
-    }
+    const CrowdPoint p = run_crowd_point(base, agents, max_gb, o.evaluations, work, self);
+    add_crowd_row(p, t);
+    points.push_back({{"agents", agents}, {"max_memory_gb", max_gb}, {"exit", p.child.status}, {"report", p.report}});
+    fit.add(p);
   }
-  const auto csv = out / "flock_crowd.csv";
-  t.write(csv);
-  plot_csv(csv, out / "flock_crowd_time.png", "crowd: seconds per evaluation and whole optimisation against agents",
-           t.col("agents"), {t.col("s_per_evaluation"), t.col("optimize_s")}, true, true);
-  plot_csv(csv, out / "flock_crowd_memory.png", "crowd: peak resident MB against agents", t.col("agents"),
-           {t.col("peak_mb")}, true, true);
-  nlohmann::json j = {{"table", t.excerpt()},
-                      {"evaluation_exponent", fitted_exponent(n, te)},
-                      {"memory_exponent", fitted_exponent(n, pk)},
-                      {"points", points}};
-  std::cout << "flock_crowd.csv\n" << t.excerpt() << "fitted exponent: per evaluation " << fmt(j["evaluation_exponent"])
-            << ", peak memory " << fmt(j["memory_exponent"]) << "\n" << std::endl;
-  return j;
+  return write_crowd_results(t, fit, points, out);
 }
 
 }  // namespace kf

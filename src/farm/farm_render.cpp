@@ -54,20 +54,22 @@ const char* describe(FrameState s) {
   return "?";
 }
 
-RenderPlan plan_render_farm(const RenderFarm& farm) {
+namespace {
+
+// Checks the request and the frame range against the run; gives the end of the range (one past the last frame).
+int checked_frame_end(const RenderFarm& farm, const render::RunData& run) {
   const render::RenderRequest& r = farm.request;
-  if (farm.chunk < 1)
-    throw InputError("--chunk: expected at least 1 frame per task, got " + std::to_string(farm.chunk));
-  render::check_request(r);
-  slurm::check(farm.slurm);
-  const render::RunData run = render::load_run(r.run_dir);
   const int F = run.trajectory.frames();
   const int end = r.frame_end < 0 ? F : r.frame_end;
   if (r.frame_begin < 0 || r.frame_begin >= F || end <= r.frame_begin || end > F)
     throw InputError("--frames " + range_text(r.frame_begin, r.frame_end) + " out of range: " + r.run_dir.string() +
                      " has frames 0.." + std::to_string(F - 1) + " (A:B renders A..B-1)");
+  return end;
+}
 
-  RenderPlan plan;
+// The range, size and chunks of frames still to render; gives how many frames are to render.
+int plan_frames(const RenderFarm& farm, const render::RunData& run, int end, RenderPlan& plan) {
+  const render::RenderRequest& r = farm.request;
   plan.name = slurm::job_name(r.run_dir.filename().string());
   plan.turntable = r.turntable > 0;
   plan.first = plan.turntable ? 0 : r.frame_begin;
@@ -81,29 +83,39 @@ RenderPlan plan_render_farm(const RenderFarm& farm) {
       todo.push_back(k);
   plan.complete = plan.last - plan.first - int(todo.size());
   plan.chunks = plan_chunks(todo, farm.chunk);
+  return int(todo.size());
+}
 
-  const std::string kf = slurm::shell_quote(farm.keyframe.string());
-  const std::string dir = slurm::shell_quote(r.run_dir.string());
-  const std::string logs = slurm::shell_quote((plan.farm_dir / "logs").string());
-  const std::string what = plan.turntable ? "turntable views" : "frames";
-  const std::string size = std::to_string(plan.width) + "x" + std::to_string(plan.height);
+// Quoted paths and words both scripts use.
+struct ScriptWords {
+  std::string kf, dir, logs, what, size;
+};
 
-  // The array: task i renders chunks[i].
+ScriptWords script_words(const RenderFarm& farm, const RenderPlan& plan) {
+  const render::RenderRequest& r = farm.request;
+  return {slurm::shell_quote(farm.keyframe.string()), slurm::shell_quote(r.run_dir.string()),
+          slurm::shell_quote((plan.farm_dir / "logs").string()), plan.turntable ? "turntable views" : "frames",
+          std::to_string(plan.width) + "x" + std::to_string(plan.height)};
+}
+
+// The array: task i renders chunks[i].
+std::string render_script(const RenderFarm& farm, const RenderPlan& plan, const ScriptWords& w, std::size_t todo) {
+  const render::RenderRequest& r = farm.request;
   std::string chunks;
   for (const auto& c : plan.chunks) {
     if (!chunks.empty()) chunks += ' ';
     chunks += range_text(c.first, c.last);
   }
   std::string s = "#!/bin/bash\n";
-  s += "# keyframe farm render: " + what + " " + std::to_string(plan.first) + ".." + std::to_string(plan.last - 1) +
-       " of " + r.run_dir.string() + ", " + std::to_string(todo.size()) + " to render in " +
-       std::to_string(plan.chunks.size()) + " tasks (" + r.backend + ", " + size + ")\n";
+  s += "# keyframe farm render: " + w.what + " " + std::to_string(plan.first) + ".." + std::to_string(plan.last - 1) +
+       " of " + r.run_dir.string() + ", " + std::to_string(todo) + " to render in " +
+       std::to_string(plan.chunks.size()) + " tasks (" + r.backend + ", " + w.size + ")\n";
   s += "#SBATCH --job-name=keyframe-render-" + plan.name + "\n";
   s += "#SBATCH --array=0-" + std::to_string(int(plan.chunks.size()) - 1) + "\n";
-  s += "#SBATCH --output=" + logs + "/render-%A_%a.out\n";
+  s += "#SBATCH --output=" + w.logs + "/render-%A_%a.out\n";
   s += slurm::sbatch_lines(farm.slurm);
   s += "set -euo pipefail\n";
-  s += "keyframe=" + kf + "\nrun=" + dir + "\n";
+  s += "keyframe=" + w.kf + "\nrun=" + w.dir + "\n";
   s += "chunks=(" + chunks + ")\n";
   s += "exec \"$keyframe\" --threads \"${SLURM_CPUS_PER_TASK:-0}\" render \"$run\"";
   if (plan.turntable)
@@ -111,28 +123,48 @@ RenderPlan plan_render_farm(const RenderFarm& farm) {
          " --views \"${chunks[$SLURM_ARRAY_TASK_ID]}\" \\\n  ";
   else
     s += " --frames \"${chunks[$SLURM_ARRAY_TASK_ID]}\" \\\n  ";
-  s += "--backend " + slurm::shell_quote(r.backend) + " --size " + size;
+  s += "--backend " + slurm::shell_quote(r.backend) + " --size " + w.size;
   if (r.spp > 0) s += " --spp " + std::to_string(r.spp);
   s += "\n";
-  plan.render_script = s;
+  return s;
+}
 
-  // The check: runs once every task has succeeded (afterok on the command line).
-  s = "#!/bin/bash\n";
-  s += "# keyframe farm render: check " + what + " " + std::to_string(plan.first) + ".." +
+// The check: runs once every task has succeeded (afterok on the command line).
+std::string check_script(const RenderFarm& farm, const RenderPlan& plan, const ScriptWords& w) {
+  const render::RenderRequest& r = farm.request;
+  std::string s = "#!/bin/bash\n";
+  s += "# keyframe farm render: check " + w.what + " " + std::to_string(plan.first) + ".." +
        std::to_string(plan.last - 1) + " of " + r.run_dir.string() + ", then encode the preview clip\n";
   s += "#SBATCH --job-name=keyframe-check-" + plan.name + "\n";
-  s += "#SBATCH --output=" + logs + "/check-%j.out\n";
+  s += "#SBATCH --output=" + w.logs + "/check-%j.out\n";
   s += "#SBATCH --kill-on-invalid-dep=yes\n";
   s += slurm::sbatch_lines(farm.slurm);
   s += "set -euo pipefail\n";
-  s += "keyframe=" + kf + "\nrun=" + dir + "\n";
+  s += "keyframe=" + w.kf + "\nrun=" + w.dir + "\n";
   s += "\"$keyframe\" farm check \"$run\"" +
        (plan.turntable ? " --turntable " + std::to_string(r.turntable)
                        : " --frames " + range_text(plan.first, plan.last)) +
-       " --size " + size + "\n";
+       " --size " + w.size + "\n";
   s += "if command -v ffmpeg >/dev/null; then\n  \"$keyframe\" clip \"$run\"" +
        std::string(plan.turntable ? " --turntable" : "") + "\nelse\n  echo \"no ffmpeg on $(hostname): no clip\"\nfi\n";
-  plan.check_script = s;
+  return s;
+}
+
+}  // namespace
+
+RenderPlan plan_render_farm(const RenderFarm& farm) {
+  const render::RenderRequest& r = farm.request;
+  if (farm.chunk < 1)
+    throw InputError("--chunk: expected at least 1 frame per task, got " + std::to_string(farm.chunk));
+  render::check_request(r);
+  slurm::check(farm.slurm);
+  const render::RunData run = render::load_run(r.run_dir);
+  const int end = checked_frame_end(farm, run);
+  RenderPlan plan;
+  const int todo = plan_frames(farm, run, end, plan);
+  const ScriptWords words = script_words(farm, plan);
+  plan.render_script = render_script(farm, plan, words, std::size_t(todo));
+  plan.check_script = check_script(farm, plan, words);
   return plan;
 }
 

@@ -98,8 +98,10 @@ Sweep parse_sweep(const std::string& text) {
   return s;
 }
 
-std::vector<SweepRun> plan_sweep(const std::vector<fs::path>& scenes, const std::vector<Sweep>& sweeps) {
-  // Run names use each key's last token, or the whole pointer when two keys end alike.
+namespace {
+
+// Run names use each key's last token, or the whole pointer when two keys end alike.
+std::vector<std::string> sweep_labels(const std::vector<Sweep>& sweeps) {
   std::vector<std::string> labels;
   std::map<std::string, int> uses;
   for (const auto& s : sweeps) ++uses[json::json_pointer(s.key).back()];
@@ -109,57 +111,84 @@ std::vector<SweepRun> plan_sweep(const std::vector<fs::path>& scenes, const std:
     for (char& c : label) c = c == '/' ? '.' : c;
     labels.push_back(plain(label, ".-_"));
   }
+  return labels;
+}
+
+// Every swept key has a block to go into in the scene file, and every value the kind the file has there.
+void check_sweeps_fit(const fs::path& file, const json& j, const std::vector<Sweep>& sweeps) {
+  for (const auto& s : sweeps) {
+    const json::json_pointer ptr(s.key);
+    const auto parent = ptr.parent_pointer();
+    if (!j.contains(parent) || !(j[parent].is_object() || j[parent].is_array()))
+      throw InputError("--sweep " + s.key + ": " + file.string() + " has no " + parent.to_string() +
+                       " block to set " + ptr.back() + " in");
+    if (j.contains(ptr))
+      for (size_t k = 0; k < s.values.size(); ++k)
+        if (kind(s.values[k]) != kind(j[ptr]))
+          throw InputError("--sweep " + s.key + "=" + s.texts[k] + ": " + file.string() + " has a " + kind(j[ptr]) +
+                           " at " + s.key + " (" + j[ptr].dump() + "), got a " + kind(s.values[k]));
+  }
+}
+
+// One scene file and what plan_sweep needs to make its runs.
+struct SweepBase {
+  const fs::path& file;
+  const Scene& scene;
+  const json& j;
+  const std::vector<Sweep>& sweeps;
+  const std::vector<std::string>& labels;
+};
+
+// The run at grid point `at` (an index into each sweep's values), checked as a scene.
+SweepRun sweep_run(const SweepBase& b, const std::vector<size_t>& at) {
+  SweepRun run;
+  run.scene = b.scene.name;
+  run.name = plain(b.scene.name, ".-_");
+  run.file = b.j;
+  run.values = json::object();
+  std::string point;
+  for (size_t i = 0; i < b.sweeps.size(); ++i) {
+    const auto& s = b.sweeps[i];
+    run.file[json::json_pointer(s.key)] = s.values[at[i]];
+    run.values[s.key] = s.values[at[i]];
+    run.name += "_" + b.labels[i] + "=" + plain(s.texts[at[i]], ".-+_");
+    point += (point.empty() ? "" : " ") + s.key + "=" + s.texts[at[i]];
+  }
+  absolutise_scene_paths(run.file, b.scene.directory);
+  try {
+    parse_scene(run.file.dump(), b.file);
+  } catch (const InputError& e) {
+    throw InputError("--sweep " + point + ": " + e.what());
+  }
+  return run;
+}
+
+// Steps `at` to the next grid point, the first sweep varying slowest; false after the last.
+bool next_grid_point(const std::vector<Sweep>& sweeps, std::vector<size_t>& at) {
+  for (size_t i = sweeps.size(); i-- > 0;) {
+    if (++at[i] < sweeps[i].values.size()) return true;
+    at[i] = 0;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::vector<SweepRun> plan_sweep(const std::vector<fs::path>& scenes, const std::vector<Sweep>& sweeps) {
+  const std::vector<std::string> labels = sweep_labels(sweeps);
   std::vector<SweepRun> runs;
   std::set<std::string> names;
   for (const auto& file : scenes) {
     const Scene base = load_scene(file);  // the scene itself first: its own errors read best
     const json j = json::parse(read_all(file));
-    for (const auto& s : sweeps) {
-      const json::json_pointer ptr(s.key);
-      const auto parent = ptr.parent_pointer();
-      if (!j.contains(parent) || !(j[parent].is_object() || j[parent].is_array()))
-        throw InputError("--sweep " + s.key + ": " + file.string() + " has no " + parent.to_string() +
-                         " block to set " + ptr.back() + " in");
-      if (j.contains(ptr))
-        for (size_t k = 0; k < s.values.size(); ++k)
-          if (kind(s.values[k]) != kind(j[ptr]))
-            throw InputError("--sweep " + s.key + "=" + s.texts[k] + ": " + file.string() + " has a " + kind(j[ptr]) +
-                             " at " + s.key + " (" + j[ptr].dump() + "), got a " + kind(s.values[k]));
-    }
-    // Every point of the grid: the first sweep varies slowest.
+    check_sweeps_fit(file, j, sweeps);
     std::vector<size_t> at(sweeps.size(), 0);
-    for (bool more = true; more;) {
-      SweepRun run;
-      run.scene = base.name;
-      run.name = plain(base.name, ".-_");
-      run.file = j;
-      run.values = json::object();
-      std::string point;
-      for (size_t i = 0; i < sweeps.size(); ++i) {
-        const auto& s = sweeps[i];
-        run.file[json::json_pointer(s.key)] = s.values[at[i]];
-        run.values[s.key] = s.values[at[i]];
-        run.name += "_" + labels[i] + "=" + plain(s.texts[at[i]], ".-+_");
-        point += (point.empty() ? "" : " ") + s.key + "=" + s.texts[at[i]];
-      }
-      absolutise_scene_paths(run.file, base.directory);
-      try {
-        parse_scene(run.file.dump(), file);
-      } catch (const InputError& e) {
-        throw InputError("--sweep " + point + ": " + e.what());
-      }
+    do {
+      SweepRun run = sweep_run({file, base, j, sweeps, labels}, at);
       if (!names.insert(run.name).second)
         throw InputError("two runs would both be named " + run.name + " (the same scene given twice?)");
       runs.push_back(std::move(run));
-      more = false;
-      for (size_t i = sweeps.size(); i-- > 0;) {
-        if (++at[i] < sweeps[i].values.size()) {
-          more = true;
-          break;
-        }
-        at[i] = 0;
-      }
-    }
+    } while (next_grid_point(sweeps, at));
   }
   return runs;
 }

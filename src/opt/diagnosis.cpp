@@ -172,11 +172,85 @@ nlohmann::json Diagnosis::to_json() const {
           {"diagnosis", line}};
 }
 
-Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensitivity& s, const RunFacts& facts) {
-  Diagnosis d;
+namespace {
+
+// The judged keyframe that missed by most, or null when none was judged.
+const KeyframeJudgement* worst_keyframe(const std::vector<KeyframeJudgement>& keyframes) {
   const KeyframeJudgement* worst = nullptr;
   for (const auto& k : keyframes)
     if (k.judged && (!worst || k.miss_after > worst->miss_after)) worst = &k;
+  return worst;
+}
+
+// Where the worst keyframe ended against its target.
+std::string miss_text(const KeyframeJudgement& worst) {
+  if (worst.tolerance.find("inside") != std::string::npos)
+    return worst.name + " ends at " + worst.error_after + " (needs " + worst.tolerance + "; " + worst.error_before +
+           " uncontrolled)";
+  return worst.name + " is " + worst.error_after + " from its target (tolerance " + worst.tolerance + "; " +
+         worst.error_before + " uncontrolled)";
+}
+
+std::string verdict_head(const Diagnosis& d, const RunFacts& facts) {
+  std::string head = !d.progress ? "no progress: "
+                     : d.far      ? "keyframes not reached: "
+                                  : "keyframes not reached, but near: ";
+  if (!d.progress)
+    head += format("the keyframe terms went from %.3g to %.3g; ", facts.keyframe_objective_start,
+                   facts.keyframe_objective_end);
+  return head;
+}
+
+std::string amplifying_cause(const Sensitivity& s, const RunFacts& facts) {
+  std::string cause = format("cause: the motion amplifies perturbations: the gradient per frame grows %.2gx from the "
+                             "keyframe back to frame %.0f (folds, sliding or buckling in contact after it)",
+                             s.growth, s.grows_from_frame) +
+                      "; change: steer over a window after that frame (controls.from_frame), keyframe earlier, or "
+                      "damp the motion (cloth.damping, cloth.air_drag, friction)";
+  if (facts.max_objective > 1e6 * std::max(facts.objective_start, 1e-300))
+    cause += format("; trial steps reached an objective of %.2g from %.2g", facts.max_objective, facts.objective_start);
+  return cause;
+}
+
+// Smooth dynamics and no budget to blame: either the effort outweighs the rest or the target is out of reach.
+std::string smooth_cause(const Sensitivity& s, const RunFacts& facts) {
+  const double phi = facts.keyframe_objective_end + facts.effort_end;
+  const double effort_share = phi > 0 ? facts.effort_end / phi : 0.0;
+  if (effort_share > 0.5)
+    return format("cause: the control effort is %.0f %% of the objective: what is left of the keyframe terms "
+                  "costs less than the force that would remove it; change: raise the keyframe's weight or lower "
+                  "controls.alpha",
+                  100 * effort_share);
+  return format("cause: the dynamics are smooth (the gradient grows %.2gx over the horizon) and the "
+                "optimiser stopped (",
+                s.growth) +
+         facts.status +
+         format("), so the target is likely out of reach: inside or behind a collider, or costing more "
+                "force than controls.alpha allows (the effort is %.0f %% of the objective); change: move the "
+                "keyframe, give the controls more time, or lower controls.alpha",
+                100 * effort_share);
+}
+
+std::string likely_cause(const Sensitivity& s, const RunFacts& facts) {
+  if (s.noisy())
+    return format("cause: the objective is noise at the start (it moves by %.2g of itself under perturbations "
+                  "of 1e-9): the start is a bifurcation, e.g. a flat sheet released in its own plane buckles "
+                  "whichever way round-off says; change: break the symmetry (a small initial velocity or offset "
+                  "out of plane) or put the keyframe later",
+                  s.relative_noise());
+  if (s.amplifying()) return amplifying_cause(s, facts);
+  if (facts.budget && (facts.recent_improvement < 0.9 || facts.evaluations < kFewEvaluations))
+    return format("cause: its budget ended it after %.0f evaluations (the objective still fell %.2gx over the "
+                  "last tenth of them); change: raise optimizer.max_evaluations",
+                  facts.evaluations, 1 / std::max(facts.recent_improvement, 1e-300));
+  return smooth_cause(s, facts);
+}
+
+}  // namespace
+
+Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensitivity& s, const RunFacts& facts) {
+  Diagnosis d;
+  const KeyframeJudgement* worst = worst_keyframe(keyframes);
   d.reached = !worst || worst->miss_after <= 1.0;
   d.far = worst && worst->miss_after > kFarMiss;
   d.progress = facts.keyframe_objective_end <= 0.5 * facts.keyframe_objective_start;
@@ -187,56 +261,7 @@ Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensit
     return d;
   }
   d.outcome = !d.progress ? "no_progress" : d.far ? "not_reached" : "near";
-  std::string what = worst->name + " is " + worst->error_after + " from its target (tolerance " + worst->tolerance +
-                     "; " + worst->error_before + " uncontrolled)";
-  if (worst->tolerance.find("inside") != std::string::npos)
-    what = worst->name + " ends at " + worst->error_after + " (needs " + worst->tolerance + "; " +
-           worst->error_before + " uncontrolled)";
-  std::string head = !d.progress ? "no progress: "
-                     : d.far      ? "keyframes not reached: "
-                                  : "keyframes not reached, but near: ";
-  if (!d.progress)
-    head += format("the keyframe terms went from %.3g to %.3g; ", facts.keyframe_objective_start,
-                   facts.keyframe_objective_end);
-  std::string cause;
-  if (s.noisy()) {
-    cause = format("cause: the objective is noise at the start (it moves by %.2g of itself under perturbations "
-                   "of 1e-9): the start is a bifurcation, e.g. a flat sheet released in its own plane buckles "
-                   "whichever way round-off says; change: break the symmetry (a small initial velocity or offset "
-                   "out of plane) or put the keyframe later",
-                   s.relative_noise());
-  } else if (s.amplifying()) {
-    cause = format("cause: the motion amplifies perturbations: the gradient per frame grows %.2gx from the "
-                   "keyframe back to frame %.0f (folds, sliding or buckling in contact after it)",
-                   s.growth, s.grows_from_frame) +
-            "; change: steer over a window after that frame (controls.from_frame), keyframe earlier, or damp "
-            "the motion (cloth.damping, cloth.air_drag, friction)";
-    if (facts.max_objective > 1e6 * std::max(facts.objective_start, 1e-300))
-      cause += format("; trial steps reached an objective of %.2g from %.2g", facts.max_objective,
-                      facts.objective_start);
-  } else if (facts.budget && (facts.recent_improvement < 0.9 || facts.evaluations < kFewEvaluations)) {
-    cause = format("cause: its budget ended it after %.0f evaluations (the objective still fell %.2gx over the "
-                   "last tenth of them); change: raise optimizer.max_evaluations",
-                   facts.evaluations, 1 / std::max(facts.recent_improvement, 1e-300));
-  } else {
-    const double phi = facts.keyframe_objective_end + facts.effort_end;
-    const double effort_share = phi > 0 ? facts.effort_end / phi : 0.0;
-    if (effort_share > 0.5)
-      cause = format("cause: the control effort is %.0f %% of the objective: what is left of the keyframe terms "
-                     "costs less than the force that would remove it; change: raise the keyframe's weight or lower "
-                     "controls.alpha",
-                     100 * effort_share);
-    else
-      cause = format("cause: the dynamics are smooth (the gradient grows %.2gx over the horizon) and the "
-                     "optimiser stopped (",
-                     s.growth) +
-              facts.status +
-              format("), so the target is likely out of reach: inside or behind a collider, or costing more "
-                     "force than controls.alpha allows (the effort is %.0f %% of the objective); change: move the "
-                     "keyframe, give the controls more time, or lower controls.alpha",
-                     100 * effort_share);
-  }
-  d.line = head + what + budget + "; " + cause;
+  d.line = verdict_head(d, facts) + miss_text(*worst) + budget + "; " + likely_cause(s, facts);
   return d;
 }
 

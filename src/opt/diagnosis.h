@@ -5,10 +5,10 @@
 // the error over the tolerance, so a miss of at most 1 is met. The run fails (keyframe optimize exits with
 // kExitNotReached) when some keyframe is not met; the outcome tells a near miss (progress, every keyframe
 // within kFarMiss tolerances) from a far one and from no meaningful progress (the keyframe terms of φ fell
-// by less than half). The cause comes from
-// measurements at the start: how much the motion amplifies a perturbation on its way to the keyframe (the
-// gradient of φ with respect to a force held over each frame, from one adjoint pass) and how noisy φ is
-// under perturbations of 1e-9 (a bifurcation such as a flat sheet released in its own plane).
+// by less than half). The cause comes from measurements at the start: how much the motion amplifies a
+// perturbation on its way to the keyframe (the gradient of φ with respect to a force held over each frame,
+// from one adjoint pass) and how noisy φ is under perturbations of 1e-9 (a bifurcation such as a flat sheet
+// released in its own plane).
 #include <string>
 #include <vector>
 

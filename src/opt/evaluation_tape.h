@@ -7,6 +7,7 @@
 // File `evaluations.bin` (little endian): 8-byte magic "KFEVAL01", uint64 n (controls), uint64 count, then
 // per evaluation: float64 phi, float64 seconds, uint8 diverged, uint32 terms, per term (uint32 length, name
 // bytes, float64 value), n float64 z, n float64 gradient.
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -37,6 +38,10 @@ class EvaluationTape {
   bool complete() const { return complete_; }  // false when the size limit stopped the recording
   const std::vector<RecordedEvaluation>& records() const { return records_; }
   int replayed() const { return int(next_); }
+  // The most this tape holds while recording `evaluations` evaluations of n controls (bytes).
+  std::uint64_t bytes_for(std::uint64_t n, std::uint64_t evaluations) const {
+    return std::min(max_bytes_, (16 * n + 64) * evaluations);
+  }
 
  private:
   std::vector<RecordedEvaluation> records_, replay_;

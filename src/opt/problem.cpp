@@ -50,31 +50,11 @@ double Problem::evaluate(const VecX& z, VecX* grad) {
   options.checkpoint_every = grad ? checkpoint_every_ : 0;
   options.memory_budget = grad ? memory_budget_ : 0;
   options.keep_for = this;
+  options.tape = grad != nullptr;  // a value alone needs no tape: a checkpointed run's last simulation stays small
   bool ok = simulate(sys_, x0_, v0_, time_.steps(), u_at, rollout_, options);
   long double phi = 0;  // extended, like each term's sum: φ's round-off is a gradient check's floor
   breakdown_.clear();
-  if (ok) {
-    VecX gx = VecX::Zero(sys_.dof()), gv = VecX::Zero(sys_.dof());
-    for (size_t k = 0; k < terms_.size(); ++k) {
-      const int n = terms_[k]->frame() * time_.substeps;
-      const double g = terms_[k]->eval(rollout_.x[n], rollout_.v[n], gx, gv);
-      breakdown_.emplace_back(terms_[k]->name() + "@" + std::to_string(terms_[k]->frame()), g);
-      phi += g;
-    }
-    VecX dz_effort = VecX::Zero(size());
-    const double e = controls_.effort(z, dz_effort);
-    breakdown_.emplace_back("effort", e);
-    phi += e;
-    ok = std::isfinite(phi);
-    if (ok && grad) {
-      grad->setZero(size());
-      backward(sys_, rollout_, u_at, *this, [&](int n, const VecX& uhat) { controls_.add_step_gradient(n, uhat, *grad); },
-               dx0_, dv0_, controls_.first_step());
-      controls_.gather_initial_velocity(dv0_, *grad);
-      *grad += dz_effort;
-      ok = grad->allFinite();
-    }
-  }
+  if (ok) ok = objective_of_rollout(z, grad, u_at, phi);
   diverged_ = !ok;
   if (ok) {
     have_good_ = true;
@@ -82,8 +62,34 @@ double Problem::evaluate(const VecX& z, VecX* grad) {
     phi_good_ = double(phi);
     return double(phi);
   }
-  // Diverged: a smooth bowl around the last good point, far above anything a good step gives. Every
-  // quantity is formed so that huge trial controls (or a huge last good point) cannot overflow it.
+  return diverged_objective(z, grad);
+}
+
+bool Problem::objective_of_rollout(const VecX& z, VecX* grad, const StepControl& u_at, long double& phi) {
+  VecX gx = VecX::Zero(sys_.dof()), gv = VecX::Zero(sys_.dof());
+  for (size_t k = 0; k < terms_.size(); ++k) {
+    const int n = terms_[k]->frame() * time_.substeps;
+    const double g = terms_[k]->eval(rollout_.x[n], rollout_.v[n], gx, gv);
+    breakdown_.emplace_back(terms_[k]->name() + "@" + std::to_string(terms_[k]->frame()), g);
+    phi += g;
+  }
+  VecX dz_effort = VecX::Zero(size());
+  const double e = controls_.effort(z, dz_effort);
+  breakdown_.emplace_back("effort", e);
+  phi += e;
+  if (!std::isfinite(phi)) return false;
+  if (!grad) return true;
+  grad->setZero(size());
+  backward(sys_, rollout_, u_at, *this, [&](int n, const VecX& uhat) { controls_.add_step_gradient(n, uhat, *grad); },
+           dx0_, dv0_, controls_.first_step());
+  controls_.gather_initial_velocity(dv0_, *grad);
+  *grad += dz_effort;
+  return grad->allFinite();
+}
+
+double Problem::diverged_objective(const VecX& z, VecX* grad) {
+  // A smooth bowl around the last good point, far above anything a good step gives. Every quantity is
+  // formed so that huge trial controls (or a huge last good point) cannot overflow it.
   const double scale = 1e6 + 1e3 * std::min(std::abs(phi_good_), 1e250);
   const VecX d = have_good_ ? VecX(z - z_good_) : VecX(z);
   const double r0 = std::hypot(1.0, std::max(1.0, z_good_.size() ? z_good_.stableNorm() : 1.0));

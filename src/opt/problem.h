@@ -53,6 +53,11 @@ class Problem : public StateCost {
   double eval(int n, const VecX& x, const VecX& v, VecX& gx, VecX& gv) const override;
 
  private:
+  // The steps of evaluate: φ (and dφ/dz) of a rollout that did not diverge, adding to `phi`; false if
+  // either is not finite. The bowl evaluate gives instead for a point that diverged.
+  bool objective_of_rollout(const VecX& z, VecX* grad, const StepControl& u_at, long double& phi);
+  double diverged_objective(const VecX& z, VecX* grad);
+
   TimeSpec time_;
   System& sys_;
   VecX v0_scene_, x0_;  // the scene's initial state, read once; controls_ is built from it

@@ -113,6 +113,55 @@ CapeAnchors load_cape_anchors(const std::filesystem::path& file) {
   return parse_cape_anchors(b);
 }
 
+namespace {
+
+// The cape's anchors: the "anchors" block, or the file beside the mesh.
+CapeAnchors read_cape_anchors(Block& b, const std::filesystem::path& mesh) {
+  if (auto anchors = b.optional_child("anchors")) return parse_cape_anchors(*anchors);
+  const auto file = cape_anchors_file(mesh);
+  if (!std::filesystem::exists(file))
+    b.fail("anchors", "expected an \"anchors\" block {\"nodes\"} or {\"points\"}, or the file " + file.string() +
+                          " beside the mesh");
+  return load_cape_anchors(file);
+}
+
+void read_body_contact(Block body, CharacterSpec& c) {
+  c.body_thickness = body.number("thickness", c.body_thickness, 1e-5, 1.0);
+  c.body_stiffness = body.number("stiffness", c.body_stiffness, 0.0, 1e8);
+  c.body_search = body.number("search", c.body_search, 0.0, 1.0);
+  c.body_friction = body.number("friction", c.body_friction, 0.0, 10.0);
+  c.body_friction_velocity = body.number("friction_velocity", c.body_friction_velocity, 1e-6, 100.0);
+  body.finish();
+}
+
+void read_self_contact(Block self, CharacterSpec& c) {
+  c.self_collision = self.boolean("enabled", c.self_collision);
+  c.self_thickness = self.number("thickness", c.self_thickness, 1e-5, 1.0);
+  c.self_stiffness = self.number("stiffness", c.self_stiffness, 0.0, 1e8);
+  c.self_friction = self.number("friction", c.self_friction, 0.0, 10.0);
+  c.self_friction_velocity = self.number("friction_velocity", c.self_friction_velocity, 1e-6, 100.0);
+  self.finish();
+}
+
+// "end_target": the state of another run's frame, as position and velocity keyframes at the last frame.
+void read_end_target(Block& end, CharacterSpec& c, Scene& scene, int p) {
+  c.target_run = scene.directory / end.string("run");
+  c.target_frame = end.integer("frame", 0, 0, 1'000'000);
+  const double wx = end.number("position_weight", 1.0, 0.0, 1e12);
+  const double wv = end.number("velocity_weight", 0.01, 0.0, 1e12);
+  VecX x, v;
+  load_run_state(end, c.target_run, c.target_frame, p, x, v);
+  end.finish();
+  PositionKeyframe position;
+  VelocityKeyframe velocity;
+  for (int i = 0; i < p; ++i) position.targets.push_back(seg(x, i)), velocity.targets.push_back(seg(v, i));
+  const int last = scene.time.frames;
+  scene.objectives.push_back({std::move(position), last, wx, {}, ObjectiveSource::kEndTarget});
+  scene.objectives.push_back({std::move(velocity), last, wv, {}, ObjectiveSource::kEndTarget});
+}
+
+}  // namespace
+
 CharacterSpec parse_character_spec(Block b, Scene& scene) {
   if (!scene.cloth) b.fail_here("expected a \"cloth\" block for the cape (a character needs a cloth)");
   CharacterSpec c;
@@ -134,54 +183,16 @@ CharacterSpec parse_character_spec(Block b, Scene& scene) {
   }
   c.offset = b.vec3("offset", Vec3::Zero());
   if (auto root = b.optional_child("root")) c.root = parse_root_motion(*root);
-  if (auto anchors = b.optional_child("anchors")) {
-    c.anchors = parse_cape_anchors(*anchors);
-  } else {
-    const auto file = cape_anchors_file(c.file);
-    if (!std::filesystem::exists(file))
-      b.fail("anchors", "expected an \"anchors\" block {\"nodes\"} or {\"points\"}, or the file " + file.string() +
-                            " beside the mesh");
-    c.anchors = load_cape_anchors(file);
-  }
-  {
-    Block body = b.child("body");
-    c.body_thickness = body.number("thickness", c.body_thickness, 1e-5, 1.0);
-    c.body_stiffness = body.number("stiffness", c.body_stiffness, 0.0, 1e8);
-    c.body_search = body.number("search", c.body_search, 0.0, 1.0);
-    c.body_friction = body.number("friction", c.body_friction, 0.0, 10.0);
-    c.body_friction_velocity = body.number("friction_velocity", c.body_friction_velocity, 1e-6, 100.0);
-    body.finish();
-  }
-  {
-    Block self = b.child("self");
-    c.self_collision = self.boolean("enabled", c.self_collision);
-    c.self_thickness = self.number("thickness", c.self_thickness, 1e-5, 1.0);
-    c.self_stiffness = self.number("stiffness", c.self_stiffness, 0.0, 1e8);
-    c.self_friction = self.number("friction", c.self_friction, 0.0, 10.0);
-    c.self_friction_velocity = self.number("friction_velocity", c.self_friction_velocity, 1e-6, 100.0);
-    self.finish();
-  }
+  c.anchors = read_cape_anchors(b, c.file);
+  read_body_contact(b.child("body"), c);
+  read_self_contact(b.child("self"), c);
   if (auto start = b.optional_child("start")) {
     c.start_run = scene.directory / start->string("run");
     c.start_frame = start->integer("frame", 0, 0, 1'000'000);
     load_run_state(*start, c.start_run, c.start_frame, p, c.start_x, c.start_v);
     start->finish();
   }
-  if (auto end = b.optional_child("end_target")) {
-    c.target_run = scene.directory / end->string("run");
-    c.target_frame = end->integer("frame", 0, 0, 1'000'000);
-    const double wx = end->number("position_weight", 1.0, 0.0, 1e12);
-    const double wv = end->number("velocity_weight", 0.01, 0.0, 1e12);
-    VecX x, v;
-    load_run_state(*end, c.target_run, c.target_frame, p, x, v);
-    end->finish();
-    PositionKeyframe position;
-    VelocityKeyframe velocity;
-    for (int i = 0; i < p; ++i) position.targets.push_back(seg(x, i)), velocity.targets.push_back(seg(v, i));
-    const int last = scene.time.frames;
-    scene.objectives.push_back({std::move(position), last, wx, {}, ObjectiveSource::kEndTarget});
-    scene.objectives.push_back({std::move(velocity), last, wv, {}, ObjectiveSource::kEndTarget});
-  }
+  if (auto end = b.optional_child("end_target")) read_end_target(*end, c, scene, p);
   b.finish();
   return c;
 }

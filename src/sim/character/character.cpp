@@ -44,6 +44,41 @@ Affine channel_local(const CharacterChannel& ch, double t) {
   return local;
 }
 
+// Vertices and triangles of all the scene's meshes together (faces that are not triangles skipped).
+void count_geometry(const aiScene& scene, int& vertices, int& triangles) {
+  vertices = triangles = 0;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    vertices += static_cast<int>(scene.mMeshes[m]->mNumVertices);
+    for (unsigned f = 0; f < scene.mMeshes[m]->mNumFaces; ++f)
+      triangles += scene.mMeshes[m]->mFaces[f].mNumIndices == 3 ? 1 : 0;
+  }
+}
+
+// The file's float weights sum to 1 only within ~1e-7; renormalised, a rigid motion of the whole
+// skeleton moves every vertex rigidly to double precision. w: kMaxInfluences per vertex.
+void renormalise_weights(double* w, unsigned vertices, int per_vertex) {
+  for (unsigned v = 0; v < vertices; ++v, w += per_vertex) {
+    double sum = 0.0;
+    for (int k = 0; k < per_vertex; ++k) sum += w[k];
+    if (sum > 0.0)
+      for (int k = 0; k < per_vertex; ++k) w[k] /= sum;
+  }
+}
+
+// The node holding mesh m (depth first from the root), or null.
+const aiNode* node_of_mesh(const aiScene& scene, unsigned m) {
+  const aiNode* mesh_node = nullptr;
+  std::vector<const aiNode*> search = {scene.mRootNode};
+  while (!search.empty() && !mesh_node) {
+    const aiNode* n = search.back();
+    search.pop_back();
+    for (unsigned i = 0; i < n->mNumMeshes; ++i)
+      if (n->mMeshes[i] == m) mesh_node = n;
+    for (unsigned c = 0; c < n->mNumChildren; ++c) search.push_back(n->mChildren[c]);
+  }
+  return mesh_node;
+}
+
 }  // namespace
 
 // Node hierarchy, parents first; by_name: node name -> index.
@@ -108,11 +143,7 @@ void Character::read_channels(const aiScene& scene, const aiAnimation* anim,
 void Character::read_meshes(const aiScene& scene, const std::unordered_map<std::string, int>& by_name,
                             const std::string& name) {
   int total_vertices = 0, total_triangles = 0;
-  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
-    total_vertices += static_cast<int>(scene.mMeshes[m]->mNumVertices);
-    for (unsigned f = 0; f < scene.mMeshes[m]->mNumFaces; ++f)
-      total_triangles += scene.mMeshes[m]->mFaces[f].mNumIndices == 3 ? 1 : 0;
-  }
+  count_geometry(scene, total_vertices, total_triangles);
   raw_vertices_.resize(3 * total_vertices);
   triangles_.resize(total_triangles, 3);
   influence_bones_.assign(kMaxInfluences * total_vertices, 0);
@@ -145,25 +176,9 @@ void Character::read_meshes(const aiScene& scene, const std::unordered_map<std::
         ++slots_used[v];
       }
     }
-    // The file's float weights sum to 1 only within ~1e-7; renormalised, a rigid motion of the whole
-    // skeleton moves every vertex rigidly to double precision.
-    for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
-      double* w = &influence_weights_[kMaxInfluences * (v0 + v)];
-      double sum = 0.0;
-      for (int k = 0; k < kMaxInfluences; ++k) sum += w[k];
-      if (sum > 0.0)
-        for (int k = 0; k < kMaxInfluences; ++k) w[k] /= sum;
-    }
+    renormalise_weights(influence_weights_.data() + kMaxInfluences * v0, mesh->mNumVertices, kMaxInfluences);
     // Vertices no bone moves follow their mesh's node rigidly (a bone with an identity offset).
-    const aiNode* mesh_node = nullptr;
-    std::vector<const aiNode*> search = {scene.mRootNode};
-    while (!search.empty() && !mesh_node) {
-      const aiNode* n = search.back();
-      search.pop_back();
-      for (unsigned i = 0; i < n->mNumMeshes; ++i)
-        if (n->mMeshes[i] == m) mesh_node = n;
-      for (unsigned c = 0; c < n->mNumChildren; ++c) search.push_back(n->mChildren[c]);
-    }
+    const aiNode* mesh_node = node_of_mesh(scene, m);
     int rigid_bone = -1;
     for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
       if (slots_used[v0 + v] > 0) continue;

@@ -55,21 +55,29 @@ int NeighborGrid::gather(int k, double r2, int cap, int* out) const {
 
 void NeighborGrid::search(const VecX& x, double radius, NeighborLists& out) {
   const int p = int(x.size() / 3);
-  if (int(cell_x_.size()) != p) {
-    size_t buckets = 1;
-    while (buckets < size_t(2 * p)) buckets *= 2;
-    bucket_mask_ = buckets - 1;
-    cell_x_.assign(p, 0);
-    cell_z_.assign(p, 0);
-    bucket_start_.assign(buckets + 1, 0);
-    bucket_cursor_.assign(buckets, 0);
-    sorted_.assign(p, 0);
-    sorted_cx_.assign(p, 0);
-    sorted_cz_.assign(p, 0);
-    sorted_px_.assign(p, 0.0);
-    sorted_pz_.assign(p, 0.0);
-    count_.assign(p, 0);
-  }
+  if (int(cell_x_.size()) != p) size_for(p);
+  sort_into_buckets(x, radius, p);
+  gather_into_slabs(radius * radius, p);
+  compact_slabs(p, out);
+}
+
+void NeighborGrid::size_for(int p) {
+  size_t buckets = 1;
+  while (buckets < size_t(2 * p)) buckets *= 2;
+  bucket_mask_ = buckets - 1;
+  cell_x_.assign(p, 0);
+  cell_z_.assign(p, 0);
+  bucket_start_.assign(buckets + 1, 0);
+  bucket_cursor_.assign(buckets, 0);
+  sorted_.assign(p, 0);
+  sorted_cx_.assign(p, 0);
+  sorted_cz_.assign(p, 0);
+  sorted_px_.assign(p, 0.0);
+  sorted_pz_.assign(p, 0.0);
+  count_.assign(p, 0);
+}
+
+void NeighborGrid::sort_into_buckets(const VecX& x, double radius, int p) {
   const double inv_cell = 1.0 / radius;
   parallel_agents(p, [&](int i) {
     cell_x_[i] = cell_index(x[3 * i], inv_cell);
@@ -90,10 +98,11 @@ void NeighborGrid::search(const VecX& x, double radius, NeighborLists& out) {
     sorted_px_[s] = x[3 * i];
     sorted_pz_[s] = x[3 * i + 2];
   }
+}
 
+void NeighborGrid::gather_into_slabs(double r2, int p) {
   // One pass in bucket order: each agent writes into its own slab of `capacity_` entries; in the rare
   // search where some agent has more neighbours than ever before, the slabs grow and the pass runs again.
-  const double r2 = radius * radius;
   if (capacity_ == 0) capacity_ = 16;
   for (;;) {
     if (slab_.size() < size_t(p) * capacity_) slab_.resize(size_t(p) * capacity_);
@@ -106,8 +115,9 @@ void NeighborGrid::search(const VecX& x, double radius, NeighborLists& out) {
     if (most <= capacity_) break;
     capacity_ = most + most / 2 + 4;
   }
+}
 
-  // Compact the slabs into the lists.
+void NeighborGrid::compact_slabs(int p, NeighborLists& out) const {
   out.start_.resize(p + 1);
   int64_t total = 0;
   for (int i = 0; i < p; ++i) {

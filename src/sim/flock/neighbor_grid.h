@@ -30,6 +30,13 @@ class NeighborGrid {
   std::span<const int> neighbors(int i) const { return lists_.neighbors(i); }
 
  private:
+  // The steps of search: work space for p agents, agents sorted by bucket, neighbours gathered per
+  // agent into slabs, slabs compacted into the lists.
+  void size_for(int p);
+  void sort_into_buckets(const VecX& x, double radius, int p);
+  void gather_into_slabs(double r2, int p);
+  void compact_slabs(int p, NeighborLists& out) const;
+
   uint64_t bucket_of(int64_t cx, int64_t cz) const;
   // Writes agent sorted_[k]'s neighbours (up to `cap`) to out; returns how many it has.
   int gather(int k, double r2, int cap, int* out) const;
