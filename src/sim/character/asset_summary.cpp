@@ -51,26 +51,10 @@ std::string fmt(double v) {
 
 std::string fmt(const Vec3& v) { return "(" + fmt(v.x()) + ", " + fmt(v.y()) + ", " + fmt(v.z()) + ")"; }
 
-}  // namespace
-
-AssetSummary summarize_asset(const std::filesystem::path& file) {
-  const std::string name = file.string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw InputError(name + ": file not found");
-  Assimp::Importer importer;
-  importer.SetPropertyInteger(AI_CONFIG_PP_LBW_MAX_WEIGHTS, Character::kMaxInfluences);
-  const aiScene* scene = importer.ReadFile(
-      name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_LimitBoneWeights);
-  if (!scene || !scene->mRootNode) throw InputError(name + ": cannot read it: " + importer.GetErrorString());
-
-  AssetSummary s;
-  s.file = name;
-  read_metadata(*scene, s);
-
-  // Nodes, parents first, with their bind-pose positions.
-  std::map<std::string, int> by_name;
+// Nodes, parents first, with their bind-pose positions; `by_name` gets each node's index.
+void read_nodes(const aiScene& scene, AssetSummary& s, std::map<std::string, int>& by_name) {
   std::vector<Affine> world;
-  std::vector<std::pair<const aiNode*, int>> stack = {{scene->mRootNode, -1}};
+  std::vector<std::pair<const aiNode*, int>> stack = {{scene.mRootNode, -1}};
   while (!stack.empty()) {
     const auto [n, parent] = stack.back();
     stack.pop_back();
@@ -85,10 +69,13 @@ AssetSummary summarize_asset(const std::filesystem::path& file) {
     s.nodes.push_back(node);
     for (unsigned c = n->mNumChildren; c-- > 0;) stack.push_back({n->mChildren[c], int(s.nodes.size()) - 1});
   }
+}
 
+// Each mesh's counts and box, the whole file's box, and which nodes are bones (at their bind pose).
+void read_meshes(const aiScene& scene, AssetSummary& s, const std::map<std::string, int>& by_name) {
   bool first = true;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh* mesh = scene->mMeshes[m];
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* mesh = scene.mMeshes[m];
     AssetMesh out;
     out.name = mesh->mName.C_Str();
     out.vertices = int(mesh->mNumVertices);
@@ -110,9 +97,12 @@ AssetSummary summarize_asset(const std::filesystem::path& file) {
     }
     s.meshes.push_back(out);
   }
+}
 
-  for (unsigned a = 0; a < scene->mNumAnimations; ++a) {
-    const aiAnimation* anim = scene->mAnimations[a];
+// Each animation's length and channels; the nodes they move are marked animated.
+void read_animations(const aiScene& scene, AssetSummary& s, const std::map<std::string, int>& by_name) {
+  for (unsigned a = 0; a < scene.mNumAnimations; ++a) {
+    const aiAnimation* anim = scene.mAnimations[a];
     AssetAnimation out;
     out.name = anim->mName.C_Str();
     out.ticks = anim->mDuration;
@@ -125,6 +115,26 @@ AssetSummary summarize_asset(const std::filesystem::path& file) {
     }
     s.animations.push_back(out);
   }
+}
+
+}  // namespace
+
+AssetSummary summarize_asset(const std::filesystem::path& file) {
+  const std::string name = file.string();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw InputError(name + ": file not found");
+  Assimp::Importer importer;
+  importer.SetPropertyInteger(AI_CONFIG_PP_LBW_MAX_WEIGHTS, Character::kMaxInfluences);
+  const aiScene* scene = importer.ReadFile(
+      name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_LimitBoneWeights);
+  if (!scene || !scene->mRootNode) throw InputError(name + ": cannot read it: " + importer.GetErrorString());
+  AssetSummary s;
+  s.file = name;
+  read_metadata(*scene, s);
+  std::map<std::string, int> by_name;
+  read_nodes(*scene, s, by_name);
+  read_meshes(*scene, s, by_name);
+  read_animations(*scene, s, by_name);
   return s;
 }
 
