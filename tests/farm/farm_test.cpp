@@ -363,6 +363,12 @@ TEST_F(FarmGather, ReportWithAStringInterruptedIsRefused) {
   expect_gather_refused("sweep/scene_alpha=0.01/report.json: /interrupted: expected true or false, got string \"no\"");
 }
 
+TEST_F(FarmGather, DeeplyNestedReportIsRefusedWithoutCrashing) {
+  write_text(dir_ / "sweep/scene_alpha=0.1/report.json",
+             R"({"x": )" + std::string(100000, '[') + std::string(100000, ']') + "}");
+  expect_gather_refused("sweep/scene_alpha=0.1/report.json: line 1: JSON nested deeper than 256 levels");
+}
+
 // Submitting a sweep again reads each run's report.json to skip finished runs: the same checks, before
 // anything is submitted or written.
 TEST_F(FarmGather, ResubmittingOverAReportWithAStringInterruptedIsRefused) {
