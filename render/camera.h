@@ -1,6 +1,7 @@
 #pragma once
 // A pinhole camera and its automatic placement around a trajectory's bounding box.
 #include "core/types.h"
+#include "render/camera_choice.h"
 #include "scene/render_spec.h"
 
 namespace kf::render {
@@ -27,8 +28,17 @@ struct Camera {
   Camera orbited(double radians) const;
 };
 
-// The scene's camera if it states one, else one framing `bounds` (flocks from high above, cloth at
-// three quarters). `is_flock` picks the view direction.
-Camera make_camera(const RenderSpec& spec, const Bounds& bounds, bool is_flock, int width, int height);
+// The camera `choice` gives (--camera, or a named view framing `bounds`), else the scene's camera if it
+// states one, else one framing `bounds` (flocks from high above, cloth at three quarters; `is_flock` picks
+// the direction). A framing camera looks at the box's centre from far enough that all eight corners of
+// `bounds` (every particle, keyframe target and collider) project inside the image.
+Camera make_camera(const RenderSpec& spec, const Bounds& bounds, bool is_flock, int width, int height,
+                   const CameraChoice& choice = {});
+
+// The distance from `bounds`' centre along `dir` (unit, toward the eye) at which every corner of `bounds`
+// lies inside a `fov`-degree (vertical) view of `aspect` = width / height, filling at most `fill` of each
+// half-extent.
+double framing_distance(const Bounds& bounds, const Vec3& dir, const Vec3& up, double fov, double aspect,
+                        double fill);
 
 }  // namespace kf::render

@@ -41,7 +41,8 @@ RunData load_run(const fs::path& run_dir) {
   return run;
 }
 
-FrameRenderer::FrameRenderer(const RunData& run, const std::string& backend, RenderSettings settings)
+FrameRenderer::FrameRenderer(const RunData& run, const std::string& backend, RenderSettings settings,
+                             const CameraChoice& choice)
     : run_(run), backend_(make_backend(backend)), settings_(settings) {
   if (settings_.width == 0) settings_.width = run.scene.render.width;
   if (settings_.height == 0) settings_.height = run.scene.render.height;
@@ -51,7 +52,7 @@ FrameRenderer::FrameRenderer(const RunData& run, const std::string& backend, Ren
                                                   [](const FlockSpec&) { return true; },  // seen from above
                                                   [](const ClothSpec&) { return false; },
                                               });
-  camera_ = make_camera(run.scene.render, bounds_, planar, settings_.width, settings_.height);
+  camera_ = make_camera(run.scene.render, bounds_, planar, settings_.width, settings_.height, choice);
 }
 
 Image FrameRenderer::render(int frame, double orbit) {

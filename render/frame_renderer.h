@@ -27,13 +27,16 @@ RunData load_run(const std::filesystem::path& run_dir);
 class FrameRenderer {
  public:
   // `backend`: a name from backend_names(); `settings` with 0 sizes/spp take the scene's values.
-  FrameRenderer(const RunData& run, const std::string& backend, RenderSettings settings);
+  // `choice`: --camera or --view, else the scene's camera or the automatic framing.
+  FrameRenderer(const RunData& run, const std::string& backend, RenderSettings settings,
+                const CameraChoice& choice = {});
   // Frame `frame` (0 <= frame < trajectory frames), camera orbited about Y by `orbit` radians.
   Image render(int frame, double orbit = 0.0);
   // A flock's path in one image: the last of `frames` with the earlier ones, trails and the centre of
   // mass added (add_flock_path). Throws InputError for a run that is not a flock.
   Image render_path(const std::vector<int>& frames);
   const RenderSettings& settings() const { return settings_; }
+  const Camera& camera() const { return camera_; }
 
  private:
   const RunData& run_;

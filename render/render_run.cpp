@@ -62,7 +62,7 @@ int render_run(const RenderRequest& request) {
     throw InputError("frames " + std::to_string(begin) + ":" + std::to_string(request.frame_end) +
                      " out of range: " + request.run_dir.string() + " has frames 0.." + std::to_string(F - 1) +
                      " (A:B renders A..B-1)");
-  FrameRenderer renderer(run, request.backend, {request.width, request.height, request.spp});
+  FrameRenderer renderer(run, request.backend, {request.width, request.height, request.spp}, request.camera);
   const bool turntable = request.turntable > 0;
   // A whole render goes into a fresh folder swapped in at the end, so no frame of an earlier, longer run
   // survives; a part (--frames A:B, --views: farm tasks rendering side by side) adds its files to frames/.

@@ -3,6 +3,8 @@
 #include <filesystem>
 #include <string>
 
+#include "render/camera_choice.h"
+
 namespace kf::render {
 
 struct RenderRequest {
@@ -14,6 +16,7 @@ struct RenderRequest {
   int frame_end = -1;              // one past the last, -1: all
   int turntable = 0;               // >0: this many frames orbiting frame_begin instead
   int view_begin = 0, view_end = -1;  // with turntable: render views view_begin..view_end-1 only (-1: all)
+  CameraChoice camera;             // --camera / --view (empty: the scene's camera or the automatic one)
 };
 
 // Throws InputError for a request out of range (backend, size, samples, turntable); reads no files.

@@ -18,6 +18,7 @@ struct MovingMesh {
   std::vector<uint32_t> indices;              // 3T
   std::vector<std::vector<float>> positions;  // per frame: 3V
   std::vector<std::vector<float>> normals;    // per frame: 3V, unit
+  std::string vertices;                       // what the vertices are (for file headers), e.g. "vertex i is particle i"
 };
 
 // Writes `gltf` (JSON) and `bin` beside it (the buffer, named by its file name in the JSON). Frame k of

@@ -18,6 +18,7 @@
 #include "render/export/checked_io.h"
 #include "render/export/point_cache.h"
 #include "render/frame_renderer.h"
+#include "render/geometry/system_geometry.h"
 
 namespace kf::render {
 
@@ -45,6 +46,7 @@ struct ExportMesh {
   std::vector<float> p, n;       // 3V each, metres / unit
   std::vector<uint32_t> indices;  // 3T
   Vec3 color;
+  std::string vertices;  // what the vertices are, for the rest OBJ's header
 };
 
 aiMesh* to_ai_mesh(const ExportMesh& m, unsigned material) {
@@ -114,7 +116,7 @@ ExportMesh from_render_mesh(const std::string& name, const Mesh& m, const Vec3& 
 ExportMesh cloth_mesh(const RunData& run, const ClothSpec& cloth, int frame) {
   const int nx = cloth.nx, ny = cloth.ny;
   const VecX& x = run.trajectory.x[size_t(frame)];
-  ExportMesh e{"cloth", {}, {}, {}, run.scene.render.cloth_front};
+  ExportMesh e{"cloth", {}, {}, {}, run.scene.render.cloth_front, "vertex i is particle i"};
   std::vector<Vec3> normal(size_t(nx) * ny, Vec3::Zero());
   for (int j = 0; j + 1 < ny; ++j)
     for (int i = 0; i + 1 < nx; ++i) {
@@ -133,24 +135,52 @@ ExportMesh cloth_mesh(const RunData& run, const ClothSpec& cloth, int frame) {
   return e;
 }
 
-// The frame's meshes: the particles as a surface (cloth grid or agent arrowheads) and the bodies.
+// The flock's agents as drawn: an arrowhead of the same vertex count per agent, in agent order.
+ExportMesh agents_mesh(const RunData& run, int frame, const Bounds& bounds, FrameGeometry& g) {
+  build_frame_geometry(run.scene, run.trajectory, frame, bounds, g);
+  ExportMesh e = from_render_mesh("agents", g.objects, run.scene.render.agent_color);
+  const size_t per = g.objects.vertices.size() / size_t(std::max(run.trajectory.particles, 1));
+  e.vertices = "agent k is vertices " + std::to_string(per) + "k.." + std::to_string(per) + "k+" +
+               std::to_string(per - 1) + " (its arrowhead, " + std::to_string(per / 3) + " flat triangles)";
+  return e;
+}
+
+// The cloth's colliders (they do not move): collider_K_SHAPE, a ground as a square around the scene.
+void add_collider_meshes(const RunData& run, const Bounds& bounds, std::vector<ExportMesh>& out) {
+  if (!run.scene.cloth) return;
+  const auto& colliders = run.scene.cloth->colliders;
+  const Vec3& color = run.scene.render.collider_color;
+  for (size_t k = 0; k < colliders.size(); ++k) {
+    const ColliderShape& shape = colliders[k].shape;
+    Mesh m;
+    if (const auto* ground = std::get_if<GroundShape>(&shape)) add_ground_square(m, *ground, bounds, color);
+    else add_collider(m, shape, color);
+    const std::string kind = std::visit([](const auto& s) { return std::string(std::decay_t<decltype(s)>::kName); }, shape);
+    ExportMesh e = from_render_mesh("collider_" + std::to_string(k) + "_" + kind, m, color);
+    e.vertices = "a static " + kind + " collider (the same every frame)";
+    out.push_back(std::move(e));
+  }
+}
+
+// The frame's meshes: the particles as a surface (cloth grid or agent arrowheads), the bodies and the
+// colliders.
 std::vector<ExportMesh> frame_meshes(const RunData& run, int frame, const Bounds& bounds, FrameGeometry& g) {
   std::vector<ExportMesh> out;
   const RenderSpec& rs = run.scene.render;
   visit_system(run.scene, Overloaded{
                               [&](const ClothSpec& cloth) { out.push_back(cloth_mesh(run, cloth, frame)); },
-                              [&](const FlockSpec&) {
-                                build_frame_geometry(run.scene, run.trajectory, frame, bounds, g);
-                                out.push_back(from_render_mesh("agents", g.objects, rs.agent_color));
-                              },
+                              [&](const FlockSpec&) { out.push_back(agents_mesh(run, frame, bounds, g)); },
                           });
   if (run.meshes) {
     for (int k = 0; k < int(run.meshes->meshes.size()); ++k) {
       Mesh body;
       add_body_mesh(*run.meshes, frame, k, rs.body_color, body);
-      out.push_back(from_render_mesh(run.meshes->meshes[size_t(k)].name, body, rs.body_color));
+      const std::string& name = run.meshes->meshes[size_t(k)].name;
+      out.push_back(from_render_mesh(name, body, rs.body_color));
+      out.back().vertices = "vertex i is vertex i of mesh \"" + name + "\" in meshes.bin";
     }
   }
+  add_collider_meshes(run, bounds, out);
   return out;
 }
 
@@ -161,7 +191,7 @@ std::vector<MovingMesh> moving_meshes(const fs::path& run_dir, const RunData& ru
   for (int f = begin; f < end; ++f) {
     std::vector<ExportMesh> frame = frame_meshes(run, f, bounds, g);
     if (out.empty())
-      for (const ExportMesh& e : frame) out.push_back({e.name, e.color, e.indices, {}, {}});
+      for (const ExportMesh& e : frame) out.push_back({e.name, e.color, e.indices, {}, {}, e.vertices});
     for (size_t k = 0; k < frame.size(); ++k) {
       if (k >= out.size() || frame[k].indices != out[k].indices)
         throw InputError(run_dir.string() + ": frame " + std::to_string(f) + ": the meshes change between frames; export per frame (obj, ply)");

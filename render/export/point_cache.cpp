@@ -10,7 +10,8 @@ namespace kf::render {
 
 void write_rest_obj(const std::filesystem::path& path, const MovingMesh& mesh) {
   write_stream_atomic(path, [&](std::ostream& out) {
-    out << "# keyframe: rest shape of \"" << mesh.name << "\" (metres, Y up); vertex i is particle i\n";
+    out << "# keyframe: rest shape of \"" << mesh.name << "\" (metres, Y up)"
+        << (mesh.vertices.empty() ? "" : "; " + mesh.vertices) << "\n";
     out << "o " << mesh.name << "\n";
     const auto& p = mesh.positions.front();
     for (size_t i = 0; i + 2 < p.size(); i += 3) out << "v " << p[i] << " " << p[i + 1] << " " << p[i + 2] << "\n";

@@ -103,7 +103,7 @@ struct RunTiles {
 
 // One run's tiles and captions, in request order (one overlaid tile with --overlay).
 RunTiles render_tiles(const FigureRequest& r, const RunData& run) {
-  FrameRenderer renderer(run, r.backend, {r.width, r.height, r.spp});
+  FrameRenderer renderer(run, r.backend, {r.width, r.height, r.spp}, r.camera);
   const std::vector<int> frames = resolve_frames(run, r.frames);
   std::vector<Image> images;
   if (r.overlay && run.scene.flock) {

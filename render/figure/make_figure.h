@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "render/camera_choice.h"
+
 namespace kf::render {
 
 // Frame numbers that stand for a frame of each run (runs may have different lengths and keyframes).
@@ -27,6 +29,7 @@ struct FigureRequest {
   std::string backend = "osmesa";
   int width = 400, height = 300;                // one tile, pixels
   int spp = 0;                                  // 0: back end default
+  CameraChoice camera;                          // --camera / --view for every tile
   bool overlay = false;                         // one tile per run instead of a strip: a flock's path
                                                 // (add_flock_path), other runs' frames superimposed
 };

@@ -8,9 +8,6 @@
 
 namespace kf::render {
 
-namespace {
-
-// Each collider shape's drawing and the box it takes (a ground is drawn as the floor, ground_plane()).
 void add_collider(Mesh& m, const ColliderShape& shape, const Vec3& color) {
   std::visit(Overloaded{
                  [](const GroundShape&) {},
@@ -21,7 +18,14 @@ void add_collider(Mesh& m, const ColliderShape& shape, const Vec3& color) {
              shape);
 }
 
-}  // namespace
+void add_ground_square(Mesh& m, const GroundShape& ground, const Bounds& bounds, const Vec3& color) {
+  const Vec3 n = ground.normal.normalized();
+  const Vec3 c0 = bounds.empty() ? ground.point : bounds.center();
+  const Vec3 c = c0 - n * n.dot(c0 - ground.point);  // the box's centre dropped onto the plane
+  const double half = 2.0 * std::max(bounds.empty() ? 1.0 : bounds.radius(), 0.25);
+  const Vec3 u = any_perpendicular(n) * half, v = n.cross(u);
+  add_flat_quad(m, c - u - v, c + u - v, c + u + v, c - u + v, n, color);
+}
 
 void add_collider_bounds(const ColliderShape& shape, Bounds& b) {
   std::visit(Overloaded{

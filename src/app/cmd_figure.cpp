@@ -2,17 +2,45 @@
 #include <iostream>
 #include <sstream>
 
+#include "app/camera_options.h"
 #include "app/commands.h"
 #include "core/error.h"
 #include "render/figure/make_figure.h"
 
 namespace kf {
 
+namespace {
+
+// --frames: comma-separated frame numbers, "key" (each run's last keyframe) or "last". Throws InputError.
+std::vector<int> parse_figure_frames(const std::string& text) {
+  std::vector<int> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    if (item == "key" || item == "last") {
+      out.push_back(item == "key" ? render::kLastKeyframe : render::kLastFrame);
+      continue;
+    }
+    try {
+      size_t used = 0;
+      const int f = std::stoi(item, &used);
+      if (used != item.size() || f < 0) throw std::invalid_argument(item);
+      out.push_back(f);
+    } catch (const std::exception&) {
+      throw InputError("--frames: expected comma-separated frame numbers, got \"" + text + "\"");
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 void add_figure_command(CLI::App& app) {
   auto* sub = app.add_subcommand("figure", "compose a typeset figure sheet (out/figures/NAME.png and NAME.pdf) from run directories");
   auto req = std::make_shared<render::FigureRequest>();
   auto frames = std::make_shared<std::string>();
   auto size = std::make_shared<std::string>();
+  auto camera = std::make_shared<CameraWords>();
   sub->add_option("RUN_DIR", req->run_dirs, "run directories, one row each")->required();
   sub->add_option("--frames", *frames,
                   "comma-separated frames, e.g. 0,30,60; 'key' = each run's last keyframe, 'last' = its last "
@@ -29,6 +57,7 @@ void add_figure_command(CLI::App& app) {
   sub->add_option("--size", *size, "tile size WxH in pixels (default 400x300)");
   sub->add_option("--spp", req->spp, "samples per pixel (default: back end default)");
   sub->add_flag("--overlay", req->overlay, "one tile per run: a flock's path (its agents at these frames, trails of a few agents, the centre of mass), other runs' frames superimposed");
+  add_camera_options(sub, *camera);
   sub->footer("Paper layouts, after keyframe run scenes/NAME.json for each run named (scripts/readme-figures makes\n"
               "them all with Embree):\n"
               "  fig. 1  keyframe figure out/square out/cross out/arch --columns --frames key\n"
@@ -39,24 +68,8 @@ void add_figure_command(CLI::App& app) {
               "  fig. 6  keyframe figure out/cape-a out/cape-blend out/cape-b --columns --frames 0,15,last");
   sub->callback([=] {
     render::FigureRequest r = *req;
-    if (!frames->empty()) {
-      std::stringstream ss(*frames);
-      std::string item;
-      while (std::getline(ss, item, ',')) {
-        if (item == "key" || item == "last") {
-          r.frames.push_back(item == "key" ? render::kLastKeyframe : render::kLastFrame);
-          continue;
-        }
-        try {
-          size_t used = 0;
-          const int f = std::stoi(item, &used);
-          if (used != item.size() || f < 0) throw std::invalid_argument(item);
-          r.frames.push_back(f);
-        } catch (const std::exception&) {
-          throw InputError("--frames: expected comma-separated frame numbers, got \"" + *frames + "\"");
-        }
-      }
-    }
+    r.camera = camera_choice(*camera);
+    if (!frames->empty()) r.frames = parse_figure_frames(*frames);
     if (!size->empty()) {
       char x = 0;
       std::stringstream ss(*size);

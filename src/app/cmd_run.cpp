@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "app/commands.h"
+#include "app/camera_options.h"
 #include "app/cli_ranges.h"
 #include "app/optimize_job.h"
 #include "render/backend.h"
@@ -15,6 +16,7 @@ void add_run_command(CLI::App& app) {
   auto opts = std::make_shared<OptimizeOptions>();
   auto req = std::make_shared<render::RenderRequest>();
   auto size = std::make_shared<std::string>();
+  auto camera = std::make_shared<CameraWords>();
   sub->add_option("SCENE", *scene, "scene file (JSON)")->required();
   add_optimize_options(sub, *opts);
   sub->add_option("--backend", req->backend, "renderer: osmesa (fast preview) or embree (ray traced)")
@@ -22,10 +24,12 @@ void add_run_command(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--size", *size, "image size WxH in pixels (default: the scene's render.width x height)");
   sub->add_option("--spp", req->spp, "samples per pixel (default: osmesa 4 (MSAA), embree render.samples)");
+  add_camera_options(sub, *camera);
   sub->footer("Example: keyframe run scenes/square.json --backend embree --size 1280x720 --spp 16");
   sub->callback([=] {
     render::RenderRequest r = *req;
-    if (!size->empty()) parse_size(*size, r.width, r.height);  // a bad size fails before the optimisation
+    if (!size->empty()) parse_size(*size, r.width, r.height);  // a bad size or camera fails before the optimisation
+    r.camera = camera_choice(*camera);
     const auto outcome = optimize_job(*scene, *opts);
     exit_if_interrupted(outcome);
     const auto& dir = outcome.dir;
