@@ -1,6 +1,7 @@
 // keyframe simulate SCENE: the uncontrolled forward simulation, saved as a trajectory.
 #include <chrono>
 #include <iostream>
+#include <string>
 
 #include "adjoint/rollout.h"
 #include "app/commands.h"
@@ -14,6 +15,19 @@
 
 namespace kf {
 namespace fs = std::filesystem;
+
+namespace {
+
+// What simulate runs: the system as System::describe gives it, without the adjoint an optimisation of it
+// would use, since simulate takes no gradient.
+std::string forward_description(const System& sys) {
+  std::string d = sys.describe();
+  for (const std::string clause : {", exact adjoint", ", swap adjoint"})
+    for (size_t at; (at = d.find(clause)) != std::string::npos;) d.erase(at, clause.size());
+  return d;
+}
+
+}  // namespace
 
 void add_simulate_command(CLI::App& app) {
   auto* sub = app.add_subcommand("simulate", "run the scene forward without controls and save the trajectory");
@@ -47,13 +61,15 @@ void add_simulate_command(CLI::App& app) {
       prepare_run_dir(work, scene);
       save_trajectory(work / "trajectory.bin", frames_of(r, scene.time, sys->particles()));
       write_body_meshes(scene, scene.time.frames + 1, work / "meshes.bin");
-      nlohmann::json report = {{"scene", scene.name}, {"command", "simulate"}, {"system", sys->describe()},
+      nlohmann::json report = {{"scene", scene.name}, {"command", "simulate"}, {"system", forward_description(*sys)},
+                               {"gradient", false},
                                {"steps", scene.time.steps()}, {"frames", scene.time.frames + 1},
                                {"simulate_seconds", secs}};
       for (const auto& [name, value] : sys->run_stats()) report["run_stats"][name] = value;
       write_json(work / "report.json", report);
     });
-    std::cout << "simulated " << scene.time.steps() << " steps of " << sys->describe() << " in " << secs
+    std::cout << "simulated " << scene.time.steps() << " steps forward (no controls, no gradient) of "
+              << forward_description(*sys) << " in " << secs
               << " s -> " << (dir / "trajectory.bin").string() << "\n";
   });
 }

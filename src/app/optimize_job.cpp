@@ -386,6 +386,17 @@ void prepare_resume(const fs::path& dir, JobResult& job, TimeSpec& z_time, std::
   stages.erase(stages.begin(), stages.end() - 1);
 }
 
+// Controls read from controls.bin under which the simulation diverges (or the objective is not finite)
+// are bad input: refused before the optimiser starts, not reported as a run that missed its keyframes.
+void check_resumed_controls(const fs::path& dir, Problem& problem, const VecX& z) {
+  problem.evaluate(z, nullptr);
+  if (!problem.last_diverged()) return;
+  std::ostringstream largest;
+  largest << std::setprecision(3) << z.cwiseAbs().maxCoeff();
+  throw InputError((dir / "controls.bin").string() + ": the simulation diverges under these controls (largest " +
+                   "magnitude " + largest.str() + "), so there is no run to resume from them");
+}
+
 // What every stage of one job shares.
 struct JobContext {
   const Scene& scene;
@@ -494,11 +505,13 @@ void run_job_stage(const JobContext& c, const std::vector<StageSpec>& stages, si
                    TimeSpec& z_time) {
   job.time.substeps = stages[s].substeps;
   if (s > 0) job.sys = make_system(c.scene, job.time.h());
+  const bool from_controls_file = c.resuming && s == 0 && job.z.size() > 0;  // see prepare_resume
   const std::string memory_line = set_up_stage(c, stages[s], job, z_time);
   // A stage at the last one's steps goes on with its pattern: under another, its best point may lie far off.
   if (job.hold_splits && int(job.schedule.size()) == job.time.steps()) cloth_of(*job.sys)->hold_schedule(job.schedule);
   else hold_split_schedule(job, job.z);
   Problem& problem = *job.problem;
+  if (from_controls_file) check_resumed_controls(c.dir, problem, job.z);
   const int stage_id = stages.size() > 1 ? int(s) + 1 : 0;
   say_stage(c, job, stage_id);
   if (problem.checkpoint_every() == 0) c.elog.say(memory_line);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -88,6 +89,26 @@ TEST_F(Cli, MissingSceneFileIsNamed) {
   const Result r = run("simulate nowhere.json", dir_);
   EXPECT_EQ(r.code, kExitInput);
   EXPECT_EQ(r.output, "keyframe: error: nowhere.json: cannot open scene file\n");
+}
+
+// simulate runs the system forward only: what it prints and writes into report.json names no adjoint
+// (System::describe names the one an optimisation would use) and says no gradient is taken.
+TEST_F(Cli, SimulateDescribesAForwardRunWithoutAGradient) {
+  for (const char* adjoint : {"exact", "swap"}) {
+    write("cloth.json", std::string(R"({"time": {"fps": 30, "frames": 3},
+      "cloth": {"nx": 4, "ny": 4, "width": 1, "height": 1, "pins": "top_corners"},
+      "optimizer": {"adjoint": ")") + adjoint + R"("}})");
+    const Result r = run("simulate cloth.json --out run", dir_);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_EQ(r.output.rfind("simulated 3 steps forward (no controls, no gradient) of cloth: 4x4 particles, ", 0), 0u)
+        << r.output;
+    EXPECT_EQ(r.output.find("adjoint"), std::string::npos) << r.output;
+    std::ifstream in(dir_ / "run/report.json");
+    const std::string report((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(report.find("\"system\": \"cloth: 4x4 particles, "), std::string::npos) << report;
+    EXPECT_NE(report.find("\"gradient\": false"), std::string::npos) << report;
+    EXPECT_EQ(report.find("adjoint"), std::string::npos) << report;
+  }
 }
 
 }  // namespace

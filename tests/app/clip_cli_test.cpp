@@ -1,6 +1,7 @@
 // keyframe clip from the command line, as the README shows it: render, then encode frames and a turntable.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 
 #include "../reliability/cli_harness.h"
@@ -38,6 +39,23 @@ TEST_F(ClipCli, RenderThenClipMp4GifAndTurntable) {
   EXPECT_FALSE(fs::exists(dir_ / "flock/turntable.mp4"));  // --gif-only
   r = run_keyframe("clip flock --ffmpeg /nonexistent/ffmpeg", dir_);
   EXPECT_EQ(r.code, kExitNotReady) << r.output;
+}
+
+// ffmpeg skips a frame it cannot decode and exits 0, so a truncated frame is refused before encoding:
+// exit 3, one line naming the frame, no clip (whether or not ffmpeg is installed).
+TEST_F(ClipCli, TruncatedFrameIsExitThreeAndNoClip) {
+  render::testing::make_flock_run(dir_ / "flock");
+  ASSERT_EQ(run_keyframe("render flock --size 64x48", dir_).code, kExitOk);
+  const fs::path frame = dir_ / "flock/frames/frame_0003.png";
+  fs::resize_file(frame, fs::file_size(frame) / 2);
+  const auto before = reliability::list_tree(dir_);
+  for (const char* args : {"clip flock --gif", "clip flock --ffmpeg /bin/true"}) {
+    const auto r = run_keyframe(args, dir_);
+    EXPECT_EQ(r.code, kExitInput) << args << "\n" << r.output;
+    EXPECT_EQ(r.output.rfind("keyframe: error: flock/frames/frame_0003.png: corrupt or truncated PNG", 0), 0u) << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_EQ(reliability::list_tree(dir_), before) << args;
+  }
 }
 
 }  // namespace

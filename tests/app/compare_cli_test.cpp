@@ -5,6 +5,7 @@
 #include "../reliability/cli_harness.h"
 #include "core/error.h"
 #include "render/image/png_io.h"
+#include "../render/png_files.h"
 
 namespace kf {
 namespace {
@@ -81,7 +82,11 @@ TEST_F(CompareCli, BadInputExitsThreeWithOneLine) {
   write_frames(dir_ / "cut");
   const std::string png = read_text(dir_ / "cut/frame_0000.png");
   reliability::write_text(dir_ / "cut/frame_0000.png", png.substr(0, png.size() - 30));
+  // A header claiming 100000 x 100000 pixels (it once ended in std::bad_alloc, exit 10).
+  write_frames(dir_ / "huge");
+  render::write_header_only_png(dir_ / "huge/frame_0001.png", 100000, 100000);
   const std::pair<const char*, const char*> cases[] = {
+      {"compare huge ref", "frame_0001.png: 100000x100000 pixels, larger than keyframe reads"},
       {"compare a ref", "frame_0002.png: missing"},
       {"compare extra ref", "missing reference for"},
       {"compare sized ref", "41x30 pixels, but the reference"},

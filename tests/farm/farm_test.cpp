@@ -363,6 +363,27 @@ TEST_F(FarmGather, ReportWithAStringInterruptedIsRefused) {
   expect_gather_refused("sweep/scene_alpha=0.01/report.json: /interrupted: expected true or false, got string \"no\"");
 }
 
+TEST_F(FarmGather, DeeplyNestedReportIsRefusedWithoutCrashing) {
+  write_text(dir_ / "sweep/scene_alpha=0.1/report.json",
+             R"({"x": )" + std::string(100000, '[') + std::string(100000, ']') + "}");
+  expect_gather_refused("sweep/scene_alpha=0.1/report.json: line 1: JSON nested deeper than 256 levels");
+}
+
+// Submitting a sweep again reads each run's report.json to skip finished runs: the same checks, before
+// anything is submitted or written.
+TEST_F(FarmGather, ResubmittingOverAReportWithAStringInterruptedIsRefused) {
+  edit("scene_alpha=0.01/report.json", "\"interrupted\": false", "\"interrupted\": \"no\"");
+  const auto before = list_tree(dir_);
+  const std::string script = read_text(dir_ / "sweep/farm/optimize.sbatch"), calls = sbatch_calls();
+  const CliResult r = farm("optimize scene.json --sweep /controls/alpha=0.01,0.1 --out sweep");
+  EXPECT_EQ(r.code, kExitInput) << r.output;
+  EXPECT_EQ(r.output, "keyframe: error: " + (dir_ / "sweep/scene_alpha=0.01/report.json").string() +
+                          ": /interrupted: expected true or false, got string \"no\"\n");
+  EXPECT_EQ(sbatch_calls(), calls) << "submitted again";
+  EXPECT_EQ(list_tree(dir_), before);
+  EXPECT_EQ(read_text(dir_ / "sweep/farm/optimize.sbatch"), script);
+}
+
 TEST_F(FarmGather, ManifestWithOddKeysIsRefused) {
   edit("sweep.json", "\"keys\": [", "\"keys\": [7, ");
   expect_gather_refused("sweep/sweep.json: /keys/0: expected a JSON pointer such as \"/cloth/stretch\", got number 7");

@@ -16,6 +16,7 @@
 #include "cli_harness.h"
 #include "core/error.h"
 #include "core/trajectory.h"
+#include "opt/controls_file.h"
 
 namespace kf::reliability {
 namespace {
@@ -187,6 +188,24 @@ TEST_F(RunDirTrust, ResumeIntoABrokenRunChangesNothingOnFailure) {
   EXPECT_NE(r.output.find("run/controls.bin: holds "), std::string::npos) << r.output;
   EXPECT_EQ(snapshot(dir_ / "run"), before2);
   for (const auto& f : list_tree(dir_)) EXPECT_EQ(f.find(".new-"), std::string::npos) << "staging left: " << f;
+}
+
+TEST_F(RunDirTrust, ResumeFromControlsTheSimulationCannotRunIsRefused) {
+  write("f.json", small_flock_scene(6));
+  ASSERT_TRUE(wrote_run(run_keyframe("optimize f.json --quiet --out run", dir_).code));
+  // A run without its record of evaluations resumes from controls.bin; controls of 1e300 make every
+  // rollout diverge. Refused up front as bad input (not "not reached", not a silent restart), run unchanged.
+  fs::remove(dir_ / "run/evaluations.bin");
+  int substeps = 0;
+  const VecX z = load_controls(dir_ / "run/controls.bin", &substeps);
+  save_controls(dir_ / "run/controls.bin", VecX::Constant(z.size(), 1e300), substeps);
+  expect_refused_unchanged("optimize --resume run --quiet", kExitInput,
+                           "run/controls.bin: the simulation diverges under these controls (largest magnitude "
+                           "1e+300), so there is no run to resume from them");
+  for (const auto& f : list_tree(dir_)) EXPECT_EQ(f.find(".new-"), std::string::npos) << "staging left: " << f;
+  // The same run with its own controls back resumes.
+  save_controls(dir_ / "run/controls.bin", z, substeps);
+  EXPECT_TRUE(wrote_run(run_keyframe("optimize --resume run --quiet", dir_).code));
 }
 
 TEST_F(RunDirTrust, ResumeWhereTrajectoryIsADirectoryReplacesTheRunWhole) {

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <tuple>
 #include <random>
 #include <vector>
 
@@ -9,10 +11,14 @@
 namespace kf {
 namespace {
 
+// The neighbours of i in the grid's documented order: by cell row (z), then cell column (x), then agent.
 std::vector<int> brute_force(const VecX& x, int i, double radius) {
   std::vector<int> out;
   for (int j = 0; j < int(x.size() / 3); ++j)
     if (j != i && (seg(x, j) - seg(x, i)).squaredNorm() < radius * radius) out.push_back(j);
+  const double inv = 1.0 / radius;
+  auto key = [&](int j) { return std::tuple(std::floor(x[3 * j + 2] * inv), std::floor(x[3 * j] * inv), j); };
+  std::sort(out.begin(), out.end(), [&](int a, int b) { return key(a) < key(b); });
   return out;
 }
 
@@ -35,14 +41,36 @@ TEST(NeighborGrid, EqualsBruteForce) {
         ASSERT_EQ(grid.agents(), p);
         for (int i = 0; i < p; ++i) {
           auto got = grid.neighbors(i);
-          std::vector<int> sorted(got.begin(), got.end());
-          std::sort(sorted.begin(), sorted.end());
           const std::vector<int> want = brute_force(x, i, radius);
-          ASSERT_EQ(sorted, want) << "p " << p << " box " << box << " radius " << radius << " agent " << i;
+          ASSERT_EQ(std::vector<int>(got.begin(), got.end()), want) << "p " << p << " box " << box << " radius " << radius << " agent " << i;
           total += long(want.size());
         }
       }
   EXPECT_GT(total, 10000) << "the configurations must actually have neighbours";
+}
+
+TEST(NeighborGrid, WrappedTableEqualsBruteForce) {
+  // A line of agents far wider than the table has columns, and a few strays far off: cells share buckets
+  // (rows and columns wrap), and lists keep their order.
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const int p = 400;
+  VecX x = VecX::Zero(3 * p);
+  for (int i = 0; i < p; ++i) x[3 * i] = 1000.0 * u(rng), x[3 * i + 2] = 2.0 * u(rng);
+  seg(x, 7) = Vec3(-3e5, 0, 4e5);
+  seg(x, 8) = Vec3(-3e5 + 0.3, 0, 4e5 - 0.2);
+  NeighborGrid grid;
+  long total = 0;
+  for (double radius : {0.5, 1.0, 3.0}) {
+    grid.build(x, radius);
+    for (int i = 0; i < p; ++i) {
+      auto got = grid.neighbors(i);
+      const std::vector<int> want = brute_force(x, i, radius);
+      ASSERT_EQ(std::vector<int>(got.begin(), got.end()), want) << "radius " << radius << " agent " << i;
+      total += long(want.size());
+    }
+  }
+  EXPECT_GT(total, 1000);
 }
 
 TEST(NeighborGrid, FarApartAndNegativeCoordinates) {

@@ -20,36 +20,36 @@ int64_t cell_index(double c, double inv_cell) {
   return int64_t(q);
 }
 
-uint64_t mix(uint64_t z) {
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
 }  // namespace
 
-uint64_t NeighborGrid::bucket_of(int64_t cx, int64_t cz) const {
-  return mix(uint64_t(cx) * 0x9E3779B97F4A7C15ULL ^ mix(uint64_t(cz))) & bucket_mask_;
+int NeighborGrid::gather_run(int k, int s, int e, int64_t cx0, int64_t cz, double r2, int cap, int* out,
+                             int n) const {
+  // Branch-free: every candidate is written to the next free entry (or the scratch one) and counted when
+  // it is in one of the run's cells (buckets may be shared by wrapped cells), within the radius and not k.
+  const double xi = sorted_px_[k], zi = sorted_pz_[k];
+  for (; s < e; ++s) {
+    const double ex = sorted_px_[s] - xi, ez = sorted_pz_[s] - zi;
+    const bool hit = (ex * ex + ez * ez < r2) & (sorted_cz_[s] == cz) & (uint64_t(sorted_cx_[s] - cx0) <= 2) & (s != k);
+    out[n < cap ? n : cap] = sorted_[s];
+    n += int(hit);
+  }
+  return n;
 }
 
 int NeighborGrid::gather(int k, double r2, int cap, int* out) const {
-  const int i = sorted_[k];
-  const double xi = sorted_px_[k], zi = sorted_pz_[k];
+  const int64_t cx = sorted_cx_[k], cz = sorted_cz_[k];
   int n = 0;
-  for (int64_t dz = -1; dz <= 1; ++dz)
-    for (int64_t dx = -1; dx <= 1; ++dx) {
-      const int64_t cx = sorted_cx_[k] + dx, cz = sorted_cz_[k] + dz;
-      const uint64_t b = bucket_of(cx, cz);
-      for (int s = bucket_start_[b], e = bucket_start_[b + 1]; s < e; ++s) {
-        // Buckets are shared by colliding cells: keep only agents of this exact cell.
-        if (sorted_cx_[s] != cx || sorted_cz_[s] != cz) continue;
-        const double ex = sorted_px_[s] - xi, ez = sorted_pz_[s] - zi;
-        if (ex * ex + ez * ez < r2 && sorted_[s] != i) {
-          if (n < cap) out[n] = sorted_[s];
-          ++n;
-        }
-      }
+  for (int64_t row = cz - 1; row <= cz + 1; ++row) {
+    if ((uint64_t(cx - 1 - origin_x_) & column_mask_) + 2 <= column_mask_) {  // three consecutive buckets
+      const uint64_t b = bucket_of(cx - 1, row);
+      n = gather_run(k, bucket_start_[b], bucket_start_[b + 3], cx - 1, row, r2, cap, out, n);
+      continue;
     }
+    for (int64_t c = cx - 1; c <= cx + 1; ++c) {  // the row wraps: one cell at a time, in column order
+      const uint64_t b = bucket_of(c, row);
+      n = gather_run(k, bucket_start_[b], bucket_start_[b + 1], c, row, r2, cap, out, n);
+    }
+  }
   return n;
 }
 
@@ -62,11 +62,12 @@ void NeighborGrid::search(const VecX& x, double radius, NeighborLists& out) {
 }
 
 void NeighborGrid::size_for(int p) {
-  size_t buckets = 1;
-  while (buckets < size_t(2 * p)) buckets *= 2;
-  bucket_mask_ = buckets - 1;
+  int buckets = 16;
+  while (buckets < 2 * p) buckets *= 2;
+  buckets_ = buckets;
   cell_x_.assign(p, 0);
   cell_z_.assign(p, 0);
+  bucket_of_agent_.assign(p, 0);
   bucket_start_.assign(buckets + 1, 0);
   bucket_cursor_.assign(buckets, 0);
   sorted_.assign(p, 0);
@@ -77,21 +78,44 @@ void NeighborGrid::size_for(int p) {
   count_.assign(p, 0);
 }
 
+void NeighborGrid::fit_table(int p) {
+  int64_t x0 = INT64_MAX, x1 = INT64_MIN, z0 = INT64_MAX, z1 = INT64_MIN;
+  for (int i = 0; i < p; ++i) {
+    x0 = std::min(x0, cell_x_[i]);
+    x1 = std::max(x1, cell_x_[i]);
+    z0 = std::min(z0, cell_z_[i]);
+    z1 = std::max(z1, cell_z_[i]);
+  }
+  if (p == 0) x0 = x1 = z0 = z1 = 0;
+  // A margin cell on each side, so a box that fits is never wrapped by a neighbour's cell either.
+  origin_x_ = x0 - 1;
+  origin_z_ = z0 - 1;
+  const uint64_t width = uint64_t(x1 - x0) + 3;
+  uint64_t columns = 1;
+  int shift = 0;
+  while (columns < width && columns < uint64_t(buckets_)) columns *= 2, ++shift;
+  column_mask_ = columns - 1;
+  row_mask_ = uint64_t(buckets_) / columns - 1;
+  row_shift_ = shift;
+}
+
 void NeighborGrid::sort_into_buckets(const VecX& x, double radius, int p) {
   const double inv_cell = 1.0 / radius;
   parallel_agents(p, [&](int i) {
     cell_x_[i] = cell_index(x[3 * i], inv_cell);
     cell_z_[i] = cell_index(x[3 * i + 2], inv_cell);
   });
+  fit_table(p);
+  parallel_agents(p, [&](int i) { bucket_of_agent_[i] = int(bucket_of(cell_x_[i], cell_z_[i])); });
 
   // Counting sort by bucket (serial: O(p) and deterministic); agents are scattered in increasing
   // order so every bucket lists its agents sorted.
   std::fill(bucket_start_.begin(), bucket_start_.end(), 0);
-  for (int i = 0; i < p; ++i) ++bucket_start_[bucket_of(cell_x_[i], cell_z_[i]) + 1];
+  for (int i = 0; i < p; ++i) ++bucket_start_[bucket_of_agent_[i] + 1];
   for (size_t b = 1; b < bucket_start_.size(); ++b) bucket_start_[b] += bucket_start_[b - 1];
-  std::copy(bucket_start_.begin(), bucket_start_.end() - 1, bucket_cursor_.begin());
+  std::copy_n(bucket_start_.data(), buckets_, bucket_cursor_.data());
   for (int i = 0; i < p; ++i) {
-    const int s = bucket_cursor_[bucket_of(cell_x_[i], cell_z_[i])]++;
+    const int s = bucket_cursor_[bucket_of_agent_[i]]++;
     sorted_[s] = i;
     sorted_cx_[s] = cell_x_[i];
     sorted_cz_[s] = cell_z_[i];
@@ -105,11 +129,12 @@ void NeighborGrid::gather_into_slabs(double r2, int p) {
   // search where some agent has more neighbours than ever before, the slabs grow and the pass runs again.
   if (capacity_ == 0) capacity_ = 16;
   for (;;) {
-    if (slab_.size() < size_t(p) * capacity_) slab_.resize(size_t(p) * capacity_);
+    const size_t stride = size_t(capacity_) + 1;
+    if (slab_.size() < size_t(p) * stride) slab_.resize(size_t(p) * stride);
     const int cap = capacity_;
     parallel_agents(p, [&](int k) {
       const int i = sorted_[k];
-      count_[i] = gather(k, r2, cap, slab_.data() + size_t(i) * cap);
+      count_[i] = gather(k, r2, cap, slab_.data() + size_t(i) * stride);
     });
     const int most = p ? *std::max_element(count_.begin(), count_.end()) : 0;
     if (most <= capacity_) break;
@@ -128,7 +153,7 @@ void NeighborGrid::compact_slabs(int p, NeighborLists& out) const {
   out.start_[p] = int(total);
   out.entries_.resize(size_t(total));
   parallel_agents(p, [&](int i) {
-    std::copy_n(slab_.data() + size_t(i) * capacity_, count_[i], out.entries_.data() + out.start_[i]);
+    std::copy_n(slab_.data() + size_t(i) * (size_t(capacity_) + 1), count_[i], out.entries_.data() + out.start_[i]);
   });
 }
 

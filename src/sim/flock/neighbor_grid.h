@@ -2,12 +2,15 @@
 // Fixed-radius neighbour lists for agents on the ground plane, by a hashed uniform grid.
 //
 // Cells are `radius` wide in x and z (the kernels' support: a 3 x 3 block of cells holds every
-// neighbour) and hashed into a table of ~2p buckets filled by a counting sort, so memory is linear in
-// agents however far the flock spreads. The agents' cells and x, z coordinates are copied in bucket
-// order, so scanning a cell reads contiguous memory, and agents are visited in that order so nearby
-// agents share cached cells. Cost is linear in agents at bounded density. After the first search with a
-// given p nothing is allocated, except that work space and lists grow (amortised) if the flock becomes
-// denser than ever before.
+// neighbour) and mapped into a table of ~2p buckets filled by a counting sort, so memory is linear in
+// agents however far the flock spreads. The table is the flock's bounding box of cells in row order,
+// wrapped when the box has more cells than the table (cells sharing a bucket are told apart by their
+// indices), so the three cells of a row of the 3 x 3 block are, unwrapped, three consecutive buckets:
+// one contiguous run of agents. The agents' cells and x, z coordinates are copied in bucket order, so a
+// run reads contiguous memory, and agents are visited in that order so nearby agents share cached cells.
+// A neighbour list is ordered by cell (z, then x) and then by agent, whatever the table's shape.
+// Cost is linear in agents at bounded density. After the first search with a given p nothing is
+// allocated, except that work space and lists grow (amortised) if the flock becomes denser than ever before.
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -33,16 +36,27 @@ class NeighborGrid {
   // The steps of search: work space for p agents, agents sorted by bucket, neighbours gathered per
   // agent into slabs, slabs compacted into the lists.
   void size_for(int p);
+  // Origin and shape of the table for the cells of the agents (the bounding box when it fits).
+  void fit_table(int p);
   void sort_into_buckets(const VecX& x, double radius, int p);
   void gather_into_slabs(double r2, int p);
   void compact_slabs(int p, NeighborLists& out) const;
 
-  uint64_t bucket_of(int64_t cx, int64_t cz) const;
-  // Writes agent sorted_[k]'s neighbours (up to `cap`) to out; returns how many it has.
+  uint64_t bucket_of(int64_t cx, int64_t cz) const {
+    return ((uint64_t(cz - origin_z_) & row_mask_) << row_shift_) | (uint64_t(cx - origin_x_) & column_mask_);
+  }
+  // Writes agent sorted_[k]'s neighbours (up to `cap`; out has cap + 1 entries, the last scratch) to out;
+  // returns how many it has.
   int gather(int k, double r2, int cap, int* out) const;
+  // The agents of slots [s, e) in cell row cz and columns [cx0, cx0 + 2] within r2 of slot k, appended.
+  int gather_run(int k, int s, int e, int64_t cx0, int64_t cz, double r2, int cap, int* out, int n) const;
 
-  uint64_t bucket_mask_ = 0;
+  int buckets_ = 0;  // a power of two, at least 16
+  int64_t origin_x_ = 0, origin_z_ = 0;  // cell (origin_x_, origin_z_) is bucket 0
+  uint64_t column_mask_ = 0, row_mask_ = 0;  // columns - 1, rows - 1 (columns x rows = buckets_)
+  int row_shift_ = 0;  // log2(columns)
   std::vector<int64_t> cell_x_, cell_z_;  // per agent
+  std::vector<int> bucket_of_agent_;      // per agent
   std::vector<int> bucket_start_;         // buckets + 1
   std::vector<int> bucket_cursor_;        // buckets
   // Per slot of the bucket order: the agent, its cell and its x and z.
@@ -50,8 +64,8 @@ class NeighborGrid {
   std::vector<int64_t> sorted_cx_, sorted_cz_;
   std::vector<double> sorted_px_, sorted_pz_;
   std::vector<int> count_;  // neighbours per agent
-  int capacity_ = 0;        // slab entries per agent
-  std::vector<int> slab_;   // p slabs of capacity_ entries, compacted into the lists
+  int capacity_ = 0;        // neighbours a slab holds
+  std::vector<int> slab_;   // p slabs of capacity_ + 1 entries, compacted into the lists
   NeighborLists lists_;
 };
 
