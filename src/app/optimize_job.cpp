@@ -391,10 +391,14 @@ void prepare_resume(const fs::path& dir, JobResult& job, TimeSpec& z_time, std::
 void check_resumed_controls(const fs::path& dir, Problem& problem, const VecX& z) {
   problem.evaluate(z, nullptr);
   if (!problem.last_diverged()) return;
+  const int step = problem.rollout().diverged_at;
   std::ostringstream largest;
   largest << std::setprecision(3) << z.cwiseAbs().maxCoeff();
-  throw InputError((dir / "controls.bin").string() + ": the simulation diverges under these controls (largest " +
-                   "magnitude " + largest.str() + "), so there is no run to resume from them");
+  throw InputError((dir / "controls.bin").string() + ": " +
+                   (step >= 0 ? "the simulation diverges at step " + std::to_string(step)
+                              : std::string("the objective is not finite")) +
+                   " under these controls (largest magnitude " + largest.str() + "), so there is no run to resume "
+                   "from them");
 }
 
 // What every stage of one job shares.

@@ -190,17 +190,17 @@ TEST_F(RunDirTrust, ResumeIntoABrokenRunChangesNothingOnFailure) {
   for (const auto& f : list_tree(dir_)) EXPECT_EQ(f.find(".new-"), std::string::npos) << "staging left: " << f;
 }
 
-TEST_F(RunDirTrust, ResumeFromControlsTheSimulationCannotRunIsRefused) {
+TEST_F(RunDirTrust, ResumeFromControlsWithNoFiniteObjectiveIsRefused) {
   write("f.json", small_flock_scene(6));
   ASSERT_TRUE(wrote_run(run_keyframe("optimize f.json --quiet --out run", dir_).code));
-  // A run without its record of evaluations resumes from controls.bin; controls of 1e300 make every
-  // rollout diverge. Refused up front as bad input (not "not reached", not a silent restart), run unchanged.
+  // A run without its record of evaluations resumes from controls.bin; controls of 1e300 give an infinite
+  // objective (their effort alone overflows). Refused up front as bad input (not "not reached", not a silent restart), run unchanged.
   fs::remove(dir_ / "run/evaluations.bin");
   int substeps = 0;
   const VecX z = load_controls(dir_ / "run/controls.bin", &substeps);
   save_controls(dir_ / "run/controls.bin", VecX::Constant(z.size(), 1e300), substeps);
   expect_refused_unchanged("optimize --resume run --quiet", kExitInput,
-                           "run/controls.bin: the simulation diverges under these controls (largest magnitude "
+                           "run/controls.bin: the objective is not finite under these controls (largest magnitude "
                            "1e+300), so there is no run to resume from them");
   for (const auto& f : list_tree(dir_)) EXPECT_EQ(f.find(".new-"), std::string::npos) << "staging left: " << f;
   // The same run with its own controls back resumes.

@@ -16,7 +16,7 @@ std::vector<int> brute_force(const VecX& x, int i, double radius) {
   std::vector<int> out;
   for (int j = 0; j < int(x.size() / 3); ++j)
     if (j != i && (seg(x, j) - seg(x, i)).squaredNorm() < radius * radius) out.push_back(j);
-  const double inv = 1.0 / radius;
+  const double inv = NeighborGrid::kReach / radius;
   auto key = [&](int j) { return std::tuple(std::floor(x[3 * j + 2] * inv), std::floor(x[3 * j] * inv), j); };
   std::sort(out.begin(), out.end(), [&](int a, int b) { return key(a) < key(b); });
   return out;

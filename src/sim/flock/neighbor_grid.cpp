@@ -22,32 +22,37 @@ int64_t cell_index(double c, double inv_cell) {
 
 }  // namespace
 
+template <bool kWrapped>
 int NeighborGrid::gather_run(int k, int s, int e, int64_t cx0, int64_t cz, double r2, int cap, int* out,
                              int n) const {
   // Branch-free: every candidate is written to the next free entry (or the scratch one) and counted when
-  // it is in one of the run's cells (buckets may be shared by wrapped cells), within the radius and not k.
+  // within the radius and not k, and in a wrapped table only when in one of the run's cells (a bucket
+  // then holds cells far apart).
   const double xi = sorted_px_[k], zi = sorted_pz_[k];
   for (; s < e; ++s) {
     const double ex = sorted_px_[s] - xi, ez = sorted_pz_[s] - zi;
-    const bool hit = (ex * ex + ez * ez < r2) & (sorted_cz_[s] == cz) & (uint64_t(sorted_cx_[s] - cx0) <= 2) & (s != k);
+    bool hit = (ex * ex + ez * ez < r2) & (s != k);
+    if constexpr (kWrapped) hit &= (sorted_cz_[s] == cz) & (uint64_t(sorted_cx_[s] - cx0) <= 2 * kReach);
     out[n < cap ? n : cap] = sorted_[s];
     n += int(hit);
   }
   return n;
 }
 
+template <bool kWrapped>
 int NeighborGrid::gather(int k, double r2, int cap, int* out) const {
   const int64_t cx = sorted_cx_[k], cz = sorted_cz_[k];
   int n = 0;
-  for (int64_t row = cz - 1; row <= cz + 1; ++row) {
-    if ((uint64_t(cx - 1 - origin_x_) & column_mask_) + 2 <= column_mask_) {  // three consecutive buckets
-      const uint64_t b = bucket_of(cx - 1, row);
-      n = gather_run(k, bucket_start_[b], bucket_start_[b + 3], cx - 1, row, r2, cap, out, n);
+  for (int64_t row = cz - kReach; row <= cz + kReach; ++row) {
+    if ((uint64_t(cx - kReach - origin_x_) & column_mask_) + 2 * kReach <= column_mask_) {  // consecutive buckets
+      const uint64_t b = bucket_of(cx - kReach, row);
+      n = gather_run<kWrapped>(k, bucket_start_[b], bucket_start_[b + 2 * kReach + 1], cx - kReach, row, r2, cap,
+                               out, n);
       continue;
     }
-    for (int64_t c = cx - 1; c <= cx + 1; ++c) {  // the row wraps: one cell at a time, in column order
+    for (int64_t c = cx - kReach; c <= cx + kReach; ++c) {  // the row wraps: one cell at a time, in column order
       const uint64_t b = bucket_of(c, row);
-      n = gather_run(k, bucket_start_[b], bucket_start_[b + 1], c, row, r2, cap, out, n);
+      n = gather_run<true>(k, bucket_start_[b], bucket_start_[b + 1], c, row, r2, cap, out, n);
     }
   }
   return n;
@@ -87,20 +92,21 @@ void NeighborGrid::fit_table(int p) {
     z1 = std::max(z1, cell_z_[i]);
   }
   if (p == 0) x0 = x1 = z0 = z1 = 0;
-  // A margin cell on each side, so a box that fits is never wrapped by a neighbour's cell either.
-  origin_x_ = x0 - 1;
-  origin_z_ = z0 - 1;
-  const uint64_t width = uint64_t(x1 - x0) + 3;
+  // A margin of kReach cells on each side, so a box that fits is never wrapped by a neighbour's cell either.
+  origin_x_ = x0 - kReach;
+  origin_z_ = z0 - kReach;
+  const uint64_t width = uint64_t(x1 - x0) + 2 * kReach + 1, depth = uint64_t(z1 - z0) + 2 * kReach + 1;
   uint64_t columns = 1;
   int shift = 0;
   while (columns < width && columns < uint64_t(buckets_)) columns *= 2, ++shift;
   column_mask_ = columns - 1;
   row_mask_ = uint64_t(buckets_) / columns - 1;
   row_shift_ = shift;
+  wrapped_ = columns < width || row_mask_ + 1 < depth;
 }
 
 void NeighborGrid::sort_into_buckets(const VecX& x, double radius, int p) {
-  const double inv_cell = 1.0 / radius;
+  const double inv_cell = kReach / radius;
   parallel_agents(p, [&](int i) {
     cell_x_[i] = cell_index(x[3 * i], inv_cell);
     cell_z_[i] = cell_index(x[3 * i + 2], inv_cell);
@@ -134,7 +140,8 @@ void NeighborGrid::gather_into_slabs(double r2, int p) {
     const int cap = capacity_;
     parallel_agents(p, [&](int k) {
       const int i = sorted_[k];
-      count_[i] = gather(k, r2, cap, slab_.data() + size_t(i) * stride);
+      int* slab = slab_.data() + size_t(i) * stride;
+      count_[i] = wrapped_ ? gather<true>(k, r2, cap, slab) : gather<false>(k, r2, cap, slab);
     });
     const int most = p ? *std::max_element(count_.begin(), count_.end()) : 0;
     if (most <= capacity_) break;

@@ -1,16 +1,17 @@
 #pragma once
 // Fixed-radius neighbour lists for agents on the ground plane, by a hashed uniform grid.
 //
-// Cells are `radius` wide in x and z (the kernels' support: a 3 x 3 block of cells holds every
-// neighbour) and mapped into a table of ~2p buckets filled by a counting sort, so memory is linear in
-// agents however far the flock spreads. The table is the flock's bounding box of cells in row order,
-// wrapped when the box has more cells than the table (cells sharing a bucket are told apart by their
-// indices), so the three cells of a row of the 3 x 3 block are, unwrapped, three consecutive buckets:
-// one contiguous run of agents. The agents' cells and x, z coordinates are copied in bucket order, so a
-// run reads contiguous memory, and agents are visited in that order so nearby agents share cached cells.
-// A neighbour list is ordered by cell (z, then x) and then by agent, whatever the table's shape.
-// Cost is linear in agents at bounded density. After the first search with a given p nothing is
-// allocated, except that work space and lists grow (amortised) if the flock becomes denser than ever before.
+// Cells are radius / kReach wide in x and z, so a (2 kReach + 1)^2 block of cells holds every neighbour
+// (smaller cells than the radius: fewer agents tested for each one found), and are mapped into a table of
+// ~2p buckets filled by a counting sort, so memory is linear in agents however far the flock spreads. The
+// table is the flock's bounding box of cells in row order, wrapped when the box has more cells than the
+// table (cells sharing a bucket are then told apart by their indices), so each row of the block is,
+// unwrapped, consecutive buckets: one contiguous run of agents. The agents' cells and x, z coordinates
+// are copied in bucket order, so a run reads contiguous memory, and agents are visited in that order so
+// nearby agents share cached cells. A neighbour list is ordered by cell (z, then x) and then by agent,
+// whatever the table's shape. Cost is linear in agents at bounded density. After the first search with a
+// given p nothing is allocated, except that work space and lists grow (amortised) if the flock becomes
+// denser than ever before.
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -22,6 +23,7 @@ namespace kf {
 
 class NeighborGrid {
  public:
+  static constexpr int kReach = 2;  // cells per radius
   // x: 3p positions (m; y ignored). Afterwards out.neighbors(i) lists every j != i with
   // (x_i - x_j)^2 + (z_i - z_j)^2 < radius^2, in an order that depends only on x (not on the thread count).
   void search(const VecX& x, double radius, NeighborLists& out);
@@ -47,14 +49,18 @@ class NeighborGrid {
   }
   // Writes agent sorted_[k]'s neighbours (up to `cap`; out has cap + 1 entries, the last scratch) to out;
   // returns how many it has.
+  // kWrapped: the table is wrapped, so candidates' cells are checked.
+  template <bool kWrapped>
   int gather(int k, double r2, int cap, int* out) const;
-  // The agents of slots [s, e) in cell row cz and columns [cx0, cx0 + 2] within r2 of slot k, appended.
+  // The agents of slots [s, e) in cell row cz and columns [cx0, cx0 + 2 kReach] within r2 of slot k, appended.
+  template <bool kWrapped>
   int gather_run(int k, int s, int e, int64_t cx0, int64_t cz, double r2, int cap, int* out, int n) const;
 
   int buckets_ = 0;  // a power of two, at least 16
   int64_t origin_x_ = 0, origin_z_ = 0;  // cell (origin_x_, origin_z_) is bucket 0
   uint64_t column_mask_ = 0, row_mask_ = 0;  // columns - 1, rows - 1 (columns x rows = buckets_)
   int row_shift_ = 0;  // log2(columns)
+  bool wrapped_ = false;  // some bucket holds more than one cell of the box
   std::vector<int64_t> cell_x_, cell_z_;  // per agent
   std::vector<int> bucket_of_agent_;      // per agent
   std::vector<int> bucket_start_;         // buckets + 1
