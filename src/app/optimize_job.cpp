@@ -19,11 +19,13 @@
 #include "core/error.h"
 #include "core/progress.h"
 #include "core/trajectory.h"
+#include "core/warnings.h"
 #include "opt/controls_file.h"
 #include "opt/diagnosis.h"
 #include "report/figure_measures.h"
 #include "opt/optimizer.h"
 #include "opt/windows.h"
+#include "scene/reach_check.h"
 #include "sim/cloth/cloth_system.h"
 #include "sim/make_system.h"
 
@@ -354,6 +356,7 @@ Scene job_scene(const fs::path& scene_file, const OptimizeOptions& opt) {
   Scene scene = !opt.resume.empty() ? load_run_scene(opt.resume) : load_scene(scene_file);
   if (!opt.adjoint.empty()) scene.optimizer.adjoint = opt.adjoint;
   if (opt.max_seconds >= 0) scene.optimizer.max_seconds = opt.max_seconds;
+  for (const std::string& w : unreachable_keyframes(scene)) warn(w);
   return scene;
 }
 

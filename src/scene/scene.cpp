@@ -162,7 +162,7 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls) {
 
 }  // namespace
 
-Scene parse_scene(const std::string& text, const std::filesystem::path& file) {
+Scene parse_scene(const std::string& text, const std::filesystem::path& file, ParamLog* log) {
   check_json_depth(text, file.string());
   Json j;
   try {
@@ -182,6 +182,10 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& file) {
   s.name = file.stem().string();
   s.directory = file.parent_path();
   Block root(j, file.string());
+  if (log) {
+    log->resolved = j;
+    root.set_log(log);
+  }
   s.seed = unsigned(root.integer("seed", 1, 0, 2'000'000'000));
   s.time = parse_time(root.child("time"));
   const bool has_flock = root.has("flock"), has_cloth = root.has("cloth");
@@ -213,13 +217,13 @@ Scene shortened(Scene scene, int frames) {
   return scene;
 }
 
-Scene load_scene(const std::filesystem::path& file) {
+Scene load_scene(const std::filesystem::path& file, ParamLog* log) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string() + ": cannot open scene file");
   std::ostringstream os;
   os << in.rdbuf();
   if (!in && !in.eof()) throw InputError(file.string() + ": cannot read scene file");
-  return parse_scene(os.str(), file);
+  return parse_scene(os.str(), file, log);
 }
 
 }  // namespace kf
