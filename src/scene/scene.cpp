@@ -150,6 +150,7 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls) {
   o.checkpoint_every = b.integer("checkpoint_every", o.checkpoint_every, 0, 10'000'000);
   o.max_memory = b.number("max_memory", o.max_memory, 0.0, 1e6);
   o.restarts = b.integer("restarts", o.restarts, 0, 1000);
+  o.split_schedule = b.string("split_schedule", o.split_schedule, {"held", "adaptive"});
   o.adjoint = b.string("adjoint", o.adjoint, {"exact", "swap"});
   o.strategy = b.string("strategy", o.strategy, {"auto", "single"});
   o.window_frames = b.integer("window_frames", o.window_frames, 1, 1'000'000);
