@@ -71,6 +71,17 @@ void check_request(const FigureRequest& r) {
   for (char c : r.name)
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.'))
       throw InputError("figure: --name \"" + r.name + "\" may use only letters, digits, '-', '_' and '.'");
+  if (!r.labels.empty() && r.labels.size() != r.run_dirs.size())
+    throw InputError("figure: --labels: expected one label per run directory (" + std::to_string(r.run_dirs.size()) +
+                     "), got " + std::to_string(r.labels.size()));
+}
+
+// What names each run on the sheet: its label, or its scene's name.
+std::vector<std::string> run_names(const FigureRequest& r, const std::vector<RunData>& runs) {
+  if (!r.labels.empty()) return r.labels;
+  std::vector<std::string> names;
+  for (const RunData& run : runs) names.push_back(sentence_case(run.scene.name));
+  return names;
 }
 
 // Every run, read whole before any rendering; each requested frame checked against each run.
@@ -111,30 +122,29 @@ RunTiles render_tiles(const FigureRequest& r, const RunData& run) {
   return t;
 }
 
-// One row per run; with one run the sheet's title already names it.
-std::vector<FigureRow> rows_by_run(const std::vector<RunData>& runs, std::vector<RunTiles>& tiles) {
+// One row per run; with one run and no label the sheet's title already names it.
+std::vector<FigureRow> rows_by_run(const std::vector<std::string>& names, bool label_one, std::vector<RunTiles>& tiles) {
   std::vector<FigureRow> rows;
-  for (size_t k = 0; k < runs.size(); ++k)
-    rows.push_back({runs.size() > 1 ? sentence_case(runs[k].scene.name) : "", std::move(tiles[k].tiles),
-                    tiles[k].captions});
+  for (size_t k = 0; k < names.size(); ++k)
+    rows.push_back({names.size() > 1 || label_one ? names[k] : "", std::move(tiles[k].tiles), tiles[k].captions});
   return rows;
 }
 
 // Transposed: row i holds every run's i-th tile; each caption names its run (and frame).
-std::vector<FigureRow> rows_by_column(const std::vector<RunData>& runs, std::vector<RunTiles>& tiles) {
+std::vector<FigureRow> rows_by_column(const std::vector<std::string>& names, std::vector<RunTiles>& tiles) {
   size_t depth = 0;
   for (const auto& t : tiles) depth = std::max(depth, t.tiles.size());
   std::vector<FigureRow> rows;
   for (size_t i = 0; i < depth; ++i) {
     FigureRow row;
     bool same = true;
-    for (size_t k = 0; k < runs.size(); ++k)
+    for (size_t k = 0; k < names.size(); ++k)
       same = same && i < tiles[k].captions.size() && tiles[k].captions[i] == tiles[0].captions[i];
     row.label = same && i < tiles[0].captions.size() ? tiles[0].captions[i] : "";
-    for (size_t k = 0; k < runs.size(); ++k) {
+    for (size_t k = 0; k < names.size(); ++k) {
       if (i >= tiles[k].tiles.size()) continue;
       row.tiles.push_back(std::move(tiles[k].tiles[i]));
-      const std::string run_name = sentence_case(runs[k].scene.name);
+      const std::string& run_name = names[k];
       row.captions.push_back(same ? run_name : run_name + ", " + lower_first(tiles[k].captions[i]));
     }
     rows.push_back(std::move(row));
@@ -149,7 +159,8 @@ std::filesystem::path make_figure(const FigureRequest& r) {
   const std::vector<RunData> runs = load_runs(r);
   std::vector<RunTiles> tiles;
   for (const RunData& run : runs) tiles.push_back(render_tiles(r, run));
-  std::vector<FigureRow> rows = r.columns ? rows_by_column(runs, tiles) : rows_by_run(runs, tiles);
+  const std::vector<std::string> names = run_names(r, runs);
+  std::vector<FigureRow> rows = r.columns ? rows_by_column(names, tiles) : rows_by_run(names, !r.labels.empty(), tiles);
   const std::string name = r.name.empty() ? runs.front().scene.name : r.name;
   const FigureSheet sheet{r.title.empty() ? sentence_case(runs.front().scene.name) : r.title, std::move(rows),
                           r.caption};

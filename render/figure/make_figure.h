@@ -21,6 +21,8 @@ struct FigureRequest {
   std::string name;                             // output file name without .png/.pdf; empty: first run's scene
   std::string title;                            // set above the sheet; empty: the first run's scene name
   std::string caption;                          // set under the sheet (e.g. the paper's caption); may be empty
+  std::vector<std::string> labels;              // one per run, naming its row (column); empty: each run's
+                                                // scene name (runs of one scene then need labels)
   std::filesystem::path out_dir = "out/figures";
   std::string backend = "osmesa";
   int width = 400, height = 300;                // one tile, pixels

@@ -21,6 +21,9 @@ void add_figure_command(CLI::App& app) {
   sub->add_option("--name", req->name, "file name without .png/.pdf (default: the first run's scene name)");
   sub->add_option("--title", req->title, "set above the sheet (default: the first run's scene name)");
   sub->add_option("--caption", req->caption, "set under the sheet, e.g. the paper's caption");
+  sub->add_option("--labels", req->labels, "comma-separated names of the runs, one per RUN_DIR in order (default: "
+                                           "each run's scene name)")
+      ->delimiter(',');
   sub->add_option("--out-dir", req->out_dir, "where the sheet goes")->capture_default_str();
   sub->add_option("--backend", req->backend, "osmesa | embree")->capture_default_str();
   sub->add_option("--size", *size, "tile size WxH in pixels (default 400x300)");

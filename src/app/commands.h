@@ -26,5 +26,6 @@ void add_clip_command(CLI::App& app);
 void add_export_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
 void add_farm_command(CLI::App& app);
+void add_inspect_command(CLI::App& app);
 
 }  // namespace kf

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <csignal>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -18,11 +19,14 @@
 #include "core/error.h"
 #include "core/progress.h"
 #include "core/trajectory.h"
+#include "core/warnings.h"
 #include "opt/controls_file.h"
 #include "opt/diagnosis.h"
 #include "report/figure_measures.h"
 #include "opt/optimizer.h"
 #include "opt/windows.h"
+#include "scene/reach_check.h"
+#include "sim/cloth/cloth_system.h"
 #include "sim/make_system.h"
 
 namespace kf {
@@ -108,7 +112,7 @@ class EvaluationLog {
 // from the best point after a stalled line search, with what is left of the budget, while they make progress.
 OptimizeResult run_stage(Problem& problem, OptimizerSpec spec, int restarts, const VecX& z, int stage_id,
                          int substeps, double seconds_before, EvaluationLog& elog, Progress& progress,
-                         EvaluationTape& tape) {
+                         EvaluationTape& tape, const std::function<bool(const VecX&, double&)>& before_restart) {
   const int budget = spec.max_evaluations;
   int used = 0;       // evaluations of the earlier starts of this stage
   double before = 0;  // and their seconds
@@ -128,7 +132,8 @@ OptimizeResult run_stage(Problem& problem, OptimizerSpec spec, int restarts, con
     before = res.seconds;
     used = int(res.history.size());
     const VecX best = res.z;
-    const double best_phi = res.phi;
+    double best_phi = res.phi;
+    if (before_restart && !before_restart(best, best_phi)) break;
     OptimizeResult more = minimize(problem, spec, best, on_eval, &g_stop, &tape);
     more.seconds += before;
     more.evaluations += res.evaluations;
@@ -202,6 +207,8 @@ struct JobResult {
   int auto_checkpoint_every = 0;  // spacing the budget asked for in the last stage (0: none)
   std::vector<StageResult> stages;
   Diagnosis diagnosis;
+  bool hold_splits = false;            // optimizer.split_schedule "held", on cloth
+  ClothSystem::StepSchedule schedule;  // the split pattern the last stage held
 };
 
 // The rollout budget of a problem within a run's budget (bytes): what the optimiser's vectors and `held` (the
@@ -321,7 +328,10 @@ void diagnose_run(const Scene& scene, JobResult& job, const EvaluationLog& elog,
 nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, size_t stages, bool resuming,
                                 JobResult& job, const EvaluationLog& elog) {
   Problem& problem = *job.problem;
+  ClothSystem* cloth = cloth_of(*job.sys);
+  if (cloth) cloth->release_schedule();  // the uncontrolled run as the scene steps it
   const UncontrolledRun uncontrolled = run_uncontrolled(scene, job);
+  if (cloth && job.hold_splits) cloth->hold_schedule(job.schedule);  // the result as the optimiser saw it
   const double final_objective = problem.evaluate(job.z, nullptr);
   const Trajectory frames = frames_of(problem.rollout(), job.time, job.sys->particles());
   write_run_files(dir, scene, job, frames, elog);
@@ -346,6 +356,7 @@ Scene job_scene(const fs::path& scene_file, const OptimizeOptions& opt) {
   Scene scene = !opt.resume.empty() ? load_run_scene(opt.resume) : load_scene(scene_file);
   if (!opt.adjoint.empty()) scene.optimizer.adjoint = opt.adjoint;
   if (opt.max_seconds >= 0) scene.optimizer.max_seconds = opt.max_seconds;
+  for (const std::string& w : unreachable_keyframes(scene)) warn(w);
   return scene;
 }
 
@@ -469,6 +480,33 @@ void record_stage(const OptimizeResult& res, JobResult& job) {
   job.interrupted = res.interrupted;
 }
 
+// A cloth step the energy check splits is a jump in φ wherever the check flips between two trial points,
+// and a line search stalls on it. Each stage simulates its start once and holds the split pattern it took;
+// gives φ there.
+double hold_split_schedule(JobResult& job, const VecX& z) {
+  ClothSystem* cloth = cloth_of(*job.sys);
+  if (!cloth || !job.hold_splits) return 0;
+  cloth->release_schedule();
+  const double phi = job.problem->evaluate(z, nullptr);
+  job.schedule = cloth->schedule();
+  cloth->hold_schedule(job.schedule);
+  return phi;
+}
+
+// Before a restart from `z` (φ = phi under the held pattern): holds the pattern z takes now, when φ is no
+// worse under it (phi becomes that φ); else keeps the old one and says not to restart.
+bool rehold_split_schedule(JobResult& job, const VecX& z, double& phi) {
+  ClothSystem::StepSchedule old = job.schedule;
+  const double now = hold_split_schedule(job, z);
+  if (now <= phi) {
+    phi = now;
+    return true;
+  }
+  job.schedule = std::move(old);
+  cloth_of(*job.sys)->hold_schedule(job.schedule);
+  return false;
+}
+
 // Stage s of the coarse-to-fine continuation: its system (the first is built already), problem and optimisation.
 void run_job_stage(const JobContext& c, const std::vector<StageSpec>& stages, size_t s, JobResult& job,
                    TimeSpec& z_time) {
@@ -476,6 +514,9 @@ void run_job_stage(const JobContext& c, const std::vector<StageSpec>& stages, si
   if (s > 0) job.sys = make_system(c.scene, job.time.h());
   const bool from_controls_file = c.resuming && s == 0 && job.z.size() > 0;  // see prepare_resume
   const std::string memory_line = set_up_stage(c, stages[s], job, z_time);
+  // A stage at the last one's steps goes on with its pattern: under another, its best point may lie far off.
+  if (job.hold_splits && int(job.schedule.size()) == job.time.steps()) cloth_of(*job.sys)->hold_schedule(job.schedule);
+  else hold_split_schedule(job, job.z);
   Problem& problem = *job.problem;
   if (from_controls_file) check_resumed_controls(c.dir, problem, job.z);
   const int stage_id = stages.size() > 1 ? int(s) + 1 : 0;
@@ -485,8 +526,10 @@ void run_job_stage(const JobContext& c, const std::vector<StageSpec>& stages, si
   spec.max_evaluations = stages[s].max_evaluations;
   if (spec.first_step < 0) spec.first_step = c.plan.scaled_first_step ? problem.control_scale() : 0;
   Progress progress("optimize " + c.scene.name, spec.max_evaluations);
+  const auto rehold = [&](const VecX& z, double& phi) { return rehold_split_schedule(job, z, phi); };
   const OptimizeResult res = run_stage(problem, spec, c.scene.optimizer.restarts, job.z, stage_id, job.time.substeps,
-                                       job.seconds, c.elog, progress, job.tape);
+                                       job.seconds, c.elog, progress, job.tape,
+                                       job.hold_splits ? rehold : std::function<bool(const VecX&, double&)>());
   progress.finish();
   record_stage(res, job);
 }
@@ -524,6 +567,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (opt.max_evaluations >= 0)
     for (auto& s : stages) s.max_evaluations = opt.max_evaluations;
   JobResult job;
+  job.hold_splits = scene.cloth && scene.optimizer.split_schedule == "held";
   TimeSpec z_time = scene.time;
   if (resuming) prepare_resume(dir, job, z_time, stages);
   check_stages_memory(scene, opt, stages);

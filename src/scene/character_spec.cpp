@@ -69,8 +69,13 @@ RootMotion parse_root_motion(Block& b) {
 
 CapeAnchors parse_cape_anchors(Block& b) {
   CapeAnchors a;
+  a.where = b.file() + ": " + b.json_pointer();
   a.mesh = b.string("mesh", "");
-  a.points = b.points3("points", 2, -100.0, 100.0);
+  if (b.has("points") == b.has("nodes"))
+    b.fail_here("expected exactly one of \"points\" ([[x, y, z], ...] in the mesh file's frame) or \"nodes\" "
+                "([\"name\", ...]; keyframe inspect MESH lists them)");
+  if (b.has("points")) a.points = b.points3("points", 2, -100.0, 100.0);
+  else a.nodes = b.strings("nodes", 2);
   b.finish();
   return a;
 }
@@ -115,7 +120,7 @@ CapeAnchors read_cape_anchors(Block& b, const std::filesystem::path& mesh) {
   if (auto anchors = b.optional_child("anchors")) return parse_cape_anchors(*anchors);
   const auto file = cape_anchors_file(mesh);
   if (!std::filesystem::exists(file))
-    b.fail("anchors", "expected an \"anchors\" block {\"mesh\", \"points\"}, or the file " + file.string() +
+    b.fail("anchors", "expected an \"anchors\" block {\"nodes\"} or {\"points\"}, or the file " + file.string() +
                           " beside the mesh");
   return load_cape_anchors(file);
 }
@@ -160,6 +165,7 @@ void read_end_target(Block& end, CharacterSpec& c, Scene& scene, int p) {
 CharacterSpec parse_character_spec(Block b, Scene& scene) {
   if (!scene.cloth) b.fail_here("expected a \"cloth\" block for the cape (a character needs a cloth)");
   CharacterSpec c;
+  c.where = b.file() + ": " + b.json_pointer();
   const int p = scene.particles();
   c.file = scene.directory / b.string("file");
   // A missing mesh is named here, before the anchors that would be looked for beside it.
@@ -171,6 +177,9 @@ CharacterSpec parse_character_spec(Block b, Scene& scene) {
     for (size_t i = 1; i < c.time_keys.size(); ++i)
       if (!(c.time_keys[i].x() > c.time_keys[i - 1].x()))
         b.fail_rel("/time/" + std::to_string(i), "expected frames in ascending order");
+  } else {
+    // The animation at its own rate from its start; the character holds its last pose after its end.
+    c.time_keys = {{0.0, 0.0}, {double(scene.time.frames), scene.time.frames / scene.time.fps}};
   }
   c.offset = b.vec3("offset", Vec3::Zero());
   if (auto root = b.optional_child("root")) c.root = parse_root_motion(*root);

@@ -7,14 +7,18 @@
 //     "file": "../assets/character/BCN_Epileptic.X",   // relative to the scene file's directory
 //     "animation": 0,
 //     "time": [[0, 0.3], [30, 1.9]],   // (frame, animation seconds) keys, frames ascending; piecewise
-//                                      // linear between keys, held before the first and after the last
+//                                      // linear between keys, held before the first and after the last;
+//                                      // default: the animation plays from its start at its own rate
+//                                      // (frame f at f / fps seconds) and holds its last pose after its end
 //     "offset": [0, 0, 0],             // world-from-file translation, metres
 //     "root": {"pivot": [0, -1.024, 0], "axis": [1, 0, 0],   // a rigid motion on top of the animation:
 //              "keys": [{"frame": 0, "translate": [0, 1.2, 0], "angle": 0}, ...]}  // translation (m) and
 //                                      // rotation (degrees) about the axis through the pivot (file frame),
 //                                      // piecewise linear between keys, held outside them
 //     "anchors": {"mesh": "Torso", "points": [[-0.18, 0.47, -0.22], ...]},
-//                                      // where the cape's top edge hangs (below); default: the file
+//                                      // where the cape's top edge hangs (below); or by node (bone)
+//                                      // names: {"nodes": ["L_Shoulder", "Neck", "R_Shoulder"]}
+//                                      // (`keyframe inspect MESH` lists them); default: the file
 //                                      // beside the mesh named like it with ".cape.json"
 //     "body": {"thickness": 0.012, "stiffness": 2000, "search": 0.06,
 //              "friction": 0, "friction_velocity": 0.01},  // Coulomb coefficient, sticking speed (m/s)
@@ -37,12 +41,15 @@ namespace kf {
 class Block;
 struct Scene;
 
-// Where a cape hangs from a character: points in the mesh file's frame (metres), ordered along the cape's
-// top edge, each followed by the nearest bind-pose vertex of mesh `mesh` ("" = every mesh). It belongs to the
-// character asset, so it is read from a file beside the mesh unless the scene states it.
+// Where a cape hangs from a character: points in the mesh file's frame (metres), or the bind-pose positions
+// of named nodes (bones), ordered along the cape's top edge, each followed by the nearest bind-pose vertex of
+// mesh `mesh` ("" = every mesh). It belongs to the character asset, so it is read from a file beside the
+// mesh unless the scene states it.
 struct CapeAnchors {
   std::string mesh;
-  std::vector<Vec3> points;
+  std::vector<Vec3> points;        // empty when `nodes` names them
+  std::vector<std::string> nodes;  // empty when `points` gives them
+  std::string where;  // "file: /json/pointer" of the block, for messages about names the mesh file lacks
 };
 
 // The anchors file beside a character mesh: "body.X" -> "body.cape.json".
@@ -64,6 +71,7 @@ struct RootMotion {
 };
 
 struct CharacterSpec {
+  std::string where;                 // "scene file: /character", for messages
   std::filesystem::path file;        // resolved against the scene's directory
   int animation = 0;
   std::vector<Vec2> time_keys{{0.0, 0.0}};  // (frame, seconds)

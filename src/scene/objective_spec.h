@@ -107,8 +107,13 @@ struct OptimizerSpec {
   // adjoint is checkpointed when keeping every step is estimated to pass it.
   double max_memory = 0;
   // Fresh L-BFGS starts from the best point after a stalled line search, within each stage's budget
-  // (an approximate gradient stalls the line search long before the objective stops falling).
-  int restarts = 0;
+  // (an approximate gradient, or a held split pattern gone stale, stalls the line search long before the
+  // objective stops falling).
+  int restarts = 5;
+  // Cloth: "held" simulates each stage's start (and each restart's) once and repeats the split pattern its
+  // energy check chose (ClothSystem::hold_schedule), so φ has no jumps where the check flips between
+  // trial points; "adaptive" checks every step of every evaluation.
+  std::string split_schedule = "held";
   // Cloth adjoint: "exact" (the transpose of the step's Jacobian) or "swap" (the paper's integrator swap).
   std::string adjoint = "exact";
   // How the run is split into stages when no schedule is given (opt/windows.h): "auto" keeps every

@@ -47,6 +47,25 @@ std::string Block::describe(const Json& v) {
 
 bool Block::has(const std::string& key) const { return j_.contains(key); }
 
+void Block::note(const std::string& key, ParamRead r) {
+  if (!log_) return;
+  r.pointer = pointer(key);
+  if (!j_.contains(key) && !r.default_value.is_null()) log_->resolved[Json::json_pointer(r.pointer)] = r.default_value;
+  log_->reads.push_back(std::move(r));
+}
+
+namespace {
+ParamRead read_of(const char* type, bool required, Json def, double lo = 0, double hi = 0, int min_count = 0) {
+  ParamRead r;
+  r.type = type;
+  r.required = required;
+  r.default_value = std::move(def);
+  r.lo = lo, r.hi = hi, r.min_count = min_count;
+  return r;
+}
+Json vec_json(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
+}  // namespace
+
 const Json* Block::find(const std::string& key) {
   read_.insert(key);
   auto it = j_.find(key);
@@ -72,11 +91,15 @@ double Block::as_number(const Json& v, const std::string& at, double lo, double 
 }
 
 double Block::number(const std::string& key, double def, double lo, double hi) {
+  note(key, read_of("number", false, def, lo, hi));
   const Json* v = find(key);
   return v ? as_number(*v, rel(key), lo, hi) : def;
 }
 
-double Block::number(const std::string& key, double lo, double hi) { return as_number(required(key), rel(key), lo, hi); }
+double Block::number(const std::string& key, double lo, double hi) {
+  note(key, read_of("number", true, nullptr, lo, hi));
+  return as_number(required(key), rel(key), lo, hi);
+}
 
 static int to_int(const Block& b, const Json& v, const std::string& at, int lo, int hi) {
   if (!v.is_number_integer() && !(v.is_number_float() && std::floor(v.get<double>()) == v.get<double>() &&
@@ -89,13 +112,18 @@ static int to_int(const Block& b, const Json& v, const std::string& at, int lo, 
 }
 
 int Block::integer(const std::string& key, int def, int lo, int hi) {
+  note(key, read_of("integer", false, def, lo, hi));
   const Json* v = find(key);
   return v ? to_int(*this, *v, rel(key), lo, hi) : def;
 }
 
-int Block::integer(const std::string& key, int lo, int hi) { return to_int(*this, required(key), rel(key), lo, hi); }
+int Block::integer(const std::string& key, int lo, int hi) {
+  note(key, read_of("integer", true, nullptr, lo, hi));
+  return to_int(*this, required(key), rel(key), lo, hi);
+}
 
 bool Block::boolean(const std::string& key, bool def) {
+  note(key, read_of("boolean", false, def));
   const Json* v = find(key);
   if (!v) return def;
   if (!v->is_boolean()) fail(key, "expected true or false, got " + describe(*v));
@@ -113,6 +141,9 @@ static std::string check_choice(const Block& b, const std::string& key, const st
 }
 
 std::string Block::string(const std::string& key, const std::string& def, const std::vector<std::string>& choices) {
+  ParamRead r = read_of("string", false, def);
+  r.choices = choices;
+  note(key, std::move(r));
   const Json* v = find(key);
   if (!v) return def;
   if (!v->is_string()) fail(key, "expected a string, got " + describe(*v));
@@ -120,12 +151,16 @@ std::string Block::string(const std::string& key, const std::string& def, const 
 }
 
 std::string Block::string(const std::string& key, const std::vector<std::string>& choices) {
+  ParamRead r = read_of("string", true, nullptr);
+  r.choices = choices;
+  note(key, std::move(r));
   const Json& v = required(key);
   if (!v.is_string()) fail(key, "expected a string, got " + describe(v));
   return check_choice(*this, key, v.get<std::string>(), choices);
 }
 
 std::vector<double> Block::numbers(const std::string& key, int min_count, double lo, double hi) {
+  note(key, read_of("numbers", true, nullptr, lo, hi, min_count));
   const Json& v = required(key);
   if (!v.is_array() || int(v.size()) < min_count)
     fail(key, "expected an array of at least " + std::to_string(min_count) + " numbers, got " + describe(v));
@@ -135,11 +170,25 @@ std::vector<double> Block::numbers(const std::string& key, int min_count, double
 }
 
 std::vector<int> Block::integers(const std::string& key, int min_count, int lo, int hi) {
+  note(key, read_of("integers", true, nullptr, lo, hi, min_count));
   const Json& v = required(key);
   if (!v.is_array() || int(v.size()) < min_count)
     fail(key, "expected an array of at least " + std::to_string(min_count) + " integers, got " + describe(v));
   std::vector<int> out;
   for (size_t i = 0; i < v.size(); ++i) out.push_back(to_int(*this, v[i], rel(key) + "/" + std::to_string(i), lo, hi));
+  return out;
+}
+
+std::vector<std::string> Block::strings(const std::string& key, int min_count) {
+  note(key, read_of("strings", true, nullptr, 0, 0, min_count));
+  const Json& v = required(key);
+  if (!v.is_array() || int(v.size()) < min_count)
+    fail(key, "expected a list of at least " + std::to_string(min_count) + " strings, got " + describe(v));
+  std::vector<std::string> out;
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (!v[i].is_string()) fail_rel(rel(key) + "/" + std::to_string(i), "expected a string, got " + describe(v[i]));
+    out.push_back(v[i].get<std::string>());
+  }
   return out;
 }
 
@@ -156,13 +205,18 @@ static Vec3 to_vec3(const Block& b, const Json& v, const std::string& at, double
 }
 
 Vec3 Block::vec3(const std::string& key, const Vec3& def, double lo, double hi) {
+  note(key, read_of("vec3", false, vec_json(def), lo, hi));
   const Json* v = find(key);
   return v ? to_vec3(*this, *v, rel(key), lo, hi) : def;
 }
 
-Vec3 Block::vec3(const std::string& key, double lo, double hi) { return to_vec3(*this, required(key), rel(key), lo, hi); }
+Vec3 Block::vec3(const std::string& key, double lo, double hi) {
+  note(key, read_of("vec3", true, nullptr, lo, hi));
+  return to_vec3(*this, required(key), rel(key), lo, hi);
+}
 
 std::vector<Vec2> Block::points2(const std::string& key, int min_count, double lo, double hi) {
+  note(key, read_of("points2", true, nullptr, lo, hi, min_count));
   const Json& v = required(key);
   if (!v.is_array() || int(v.size()) < min_count)
     fail(key, "expected a list of at least " + std::to_string(min_count) + " [a, b] points, got " + describe(v));
@@ -178,6 +232,7 @@ std::vector<Vec2> Block::points2(const std::string& key, int min_count, double l
 }
 
 std::vector<Vec3> Block::points3(const std::string& key, int min_count, double lo, double hi) {
+  note(key, read_of("points3", true, nullptr, lo, hi, min_count));
   const Json& v = required(key);
   if (!v.is_array() || int(v.size()) < min_count)
     fail(key, "expected a list of at least " + std::to_string(min_count) + " [x, y, z] points, got " + describe(v));
@@ -187,14 +242,17 @@ std::vector<Vec3> Block::points3(const std::string& key, int min_count, double l
 }
 
 Block Block::child(const std::string& key) {
+  note(key, read_of("object", false, nullptr));
   const Json* v = find(key);
-  if (!v) return Block(Json::object(), file_, pointer(key));
-  if (!v->is_object()) fail(key, "expected an object, got " + describe(*v));
-  return Block(*v, file_, pointer(key));
+  if (v && !v->is_object()) fail(key, "expected an object, got " + describe(*v));
+  Block b(v ? *v : Json::object(), file_, pointer(key));
+  b.log_ = log_;
+  return b;
 }
 
 std::optional<Block> Block::optional_child(const std::string& key) {
   if (!has(key)) {
+    note(key, read_of("object", false, nullptr));
     read_.insert(key);
     return std::nullopt;
   }
@@ -202,6 +260,7 @@ std::optional<Block> Block::optional_child(const std::string& key) {
 }
 
 std::vector<Block> Block::array(const std::string& key, int min_count) {
+  note(key, read_of("array", min_count > 0, min_count > 0 ? Json() : Json::array(), 0, 0, min_count));
   const Json* v = find(key);
   if (!v) {
     if (min_count > 0) fail(key, "required key is missing");
@@ -213,6 +272,7 @@ std::vector<Block> Block::array(const std::string& key, int min_count) {
   for (size_t i = 0; i < v->size(); ++i) {
     if (!(*v)[i].is_object()) fail_rel(rel(key) + "/" + std::to_string(i), "expected an object, got " + describe((*v)[i]));
     out.emplace_back((*v)[i], file_, pointer(key) + "/" + std::to_string(i));
+    out.back().log_ = log_;
   }
   return out;
 }

@@ -15,6 +15,24 @@ namespace kf {
 
 using Json = nlohmann::json;
 
+// One key a parse read: for `keyframe inspect SCENE` (the scene with every default filled in) and
+// `keyframe schema` (each key's type, range, default and choices).
+struct ParamRead {
+  std::string pointer;  // JSON pointer of the key, array indices included: "/objectives/0/weight"
+  std::string type;     // number, integer, boolean, string, vec3, points2, points3, numbers, integers, object, array
+  bool required = false;
+  Json default_value;   // used when the key is absent (null: required, or no default)
+  double lo = 0, hi = 0;  // range of the value, or of each of its numbers
+  int min_count = 0;      // lists: at least this many entries
+  std::vector<std::string> choices;  // strings: the values allowed (empty: any)
+};
+
+// What a whole parse read. Blocks made by child() and array() write to their parent's log.
+struct ParamLog {
+  std::vector<ParamRead> reads;
+  Json resolved;  // the file as read, with every absent key that has a default filled in
+};
+
 class Block {
  public:
   // `file` is used in messages only; `pointer` is the JSON pointer of `j` ("" for the root).
@@ -35,6 +53,7 @@ class Block {
   std::vector<Vec3> points3(const std::string& key, int min_count, double lo = -1e6, double hi = 1e6);
   std::vector<double> numbers(const std::string& key, int min_count, double lo, double hi);
   std::vector<int> integers(const std::string& key, int min_count, int lo, int hi);
+  std::vector<std::string> strings(const std::string& key, int min_count);
 
   // Nested blocks. `child` of a missing optional key gives a Block over an empty object.
   Block child(const std::string& key);
@@ -49,7 +68,10 @@ class Block {
   [[noreturn]] void fail_rel(const std::string& rel, const std::string& expected) const;
   std::string pointer(const std::string& key) const;
   const std::string& file() const { return file_; }
+  const std::string& json_pointer() const { return pointer_; }  // "" for the root
   const Json& json() const { return j_; }
+  // Record every key read from here on (and in the blocks made from this one) into `log` (may be null).
+  void set_log(ParamLog* log) { log_ = log; }
 
  private:
   const Json* find(const std::string& key);
@@ -57,10 +79,13 @@ class Block {
   double as_number(const Json& v, const std::string& key, double lo, double hi) const;
   static std::string describe(const Json& v);
   static std::string rel(const std::string& key);
+  void note(const std::string& key, ParamRead r);  // into log_, if any
+
 
   Json j_;
   std::string file_, pointer_;
   std::set<std::string> read_;
+  ParamLog* log_ = nullptr;
 };
 
 // Escapes a key for use inside a JSON pointer (RFC 6901).

@@ -150,6 +150,7 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls) {
   o.checkpoint_every = b.integer("checkpoint_every", o.checkpoint_every, 0, 10'000'000);
   o.max_memory = b.number("max_memory", o.max_memory, 0.0, 1e6);
   o.restarts = b.integer("restarts", o.restarts, 0, 1000);
+  o.split_schedule = b.string("split_schedule", o.split_schedule, {"held", "adaptive"});
   o.adjoint = b.string("adjoint", o.adjoint, {"exact", "swap"});
   o.strategy = b.string("strategy", o.strategy, {"auto", "single"});
   o.window_frames = b.integer("window_frames", o.window_frames, 1, 1'000'000);
@@ -161,7 +162,7 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls) {
 
 }  // namespace
 
-Scene parse_scene(const std::string& text, const std::filesystem::path& file) {
+Scene parse_scene(const std::string& text, const std::filesystem::path& file, ParamLog* log) {
   check_json_depth(text, file.string());
   Json j;
   try {
@@ -181,6 +182,10 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& file) {
   s.name = file.stem().string();
   s.directory = file.parent_path();
   Block root(j, file.string());
+  if (log) {
+    log->resolved = j;
+    root.set_log(log);
+  }
   s.seed = unsigned(root.integer("seed", 1, 0, 2'000'000'000));
   s.time = parse_time(root.child("time"));
   const bool has_flock = root.has("flock"), has_cloth = root.has("cloth");
@@ -212,13 +217,13 @@ Scene shortened(Scene scene, int frames) {
   return scene;
 }
 
-Scene load_scene(const std::filesystem::path& file) {
+Scene load_scene(const std::filesystem::path& file, ParamLog* log) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string() + ": cannot open scene file");
   std::ostringstream os;
   os << in.rdbuf();
   if (!in && !in.eof()) throw InputError(file.string() + ": cannot read scene file");
-  return parse_scene(os.str(), file);
+  return parse_scene(os.str(), file, log);
 }
 
 }  // namespace kf

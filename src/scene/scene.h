@@ -42,10 +42,13 @@ decltype(auto) visit_system(const Scene& scene, F&& f) {
   return f(*scene.cloth);
 }
 
+struct ParamLog;
+
 // Loads and validates a scene file. Throws InputError with "file: /pointer: expected ..." on any problem.
-Scene load_scene(const std::filesystem::path& file);
+// `log`, when given, receives every key read and the scene with its defaults filled in (keyframe inspect).
+Scene load_scene(const std::filesystem::path& file, ParamLog* log = nullptr);
 // The same from JSON text already in memory (used by tests and the fuzzer); `file` names it in messages.
-Scene parse_scene(const std::string& text, const std::filesystem::path& file);
+Scene parse_scene(const std::string& text, const std::filesystem::path& file, ParamLog* log = nullptr);
 
 // The scene cut to its first `frames` frames (unchanged when frames <= 0 or not fewer than it has), its
 // keyframes moved proportionally (gradient checks and benchmarks of long scenes).

@@ -2,6 +2,8 @@
 
 #include "core/error.h"
 #include "core/overloaded.h"
+#include "sim/cape/cape_system.h"
+#include "sim/cloth/cloth_system.h"
 
 namespace kf {
 
@@ -14,6 +16,12 @@ std::unique_ptr<System> make_system(const Scene& scene, double h_override) {
                                    return scene.character ? make_cape_system(scene, h) : make_cloth_system(scene, h);
                                  },
                              });
+}
+
+ClothSystem* cloth_of(System& sys) {
+  if (auto* cloth = dynamic_cast<ClothSystem*>(&sys)) return cloth;
+  if (auto* cape = dynamic_cast<CapeSystem*>(&sys)) return &cape->cloth();
+  return nullptr;
 }
 
 }  // namespace kf

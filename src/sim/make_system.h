@@ -7,8 +7,13 @@
 
 namespace kf {
 
+class ClothSystem;
+
 // `h_override` > 0 replaces the scene's step length (gradcheck studies, coarse-to-fine).
 std::unique_ptr<System> make_system(const Scene& scene, double h_override = 0);
+
+// The sheet a system steps (a cloth scene's, or a cape's), or null (a flock).
+ClothSystem* cloth_of(System& sys);
 
 // Implemented by each family.
 std::unique_ptr<System> make_flock_system(const Scene& scene, double h);

@@ -138,6 +138,59 @@ TEST(Figure, StripOfTwoRunsAndOverlay) {
   EXPECT_FALSE(std::filesystem::exists(tmp.path() / "figures/bad.pdf"));
 }
 
+// Mean absolute difference (levels) between the bands of `h` pixel rows just above y = a in one image and
+// y = b in another, across the whole width.
+double band_difference(const Image& one, int a, const Image& other, int b, int h) {
+  if (a < h || b < h || a > one.height || b > other.height || one.width != other.width) return 1e9;
+  double sum = 0;
+  long n = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < one.width; ++x)
+      for (int c = 0; c < 3; ++c, ++n) sum += std::abs(int(one.at(x, a - h + y)[c]) - int(other.at(x, b - h + y)[c]));
+  return sum / double(n);
+}
+
+// Two runs of one scene: by default both rows are labelled with the scene's name; `labels` names each row.
+TEST(Figure, LabelsNameEachRunsRow) {
+  testing::TempDir tmp;
+  FigureRequest r;
+  r.run_dirs = {testing::make_flock_run(tmp.path() / "a"), testing::make_flock_run(tmp.path() / "b")};
+  r.frames = {0};
+  r.width = 80;
+  r.height = 60;
+  r.out_dir = tmp.path() / "figures";
+  r.name = "plain";
+  const Image plain = read_png(make_figure(r));
+  r.name = "labelled";
+  r.labels = {"Before", "After"};
+  const Image labelled = read_png(make_figure(r));
+  ASSERT_EQ(labelled.width, plain.width);
+  ASSERT_EQ(labelled.height, plain.height);
+
+  const RunData run = load_run(r.run_dirs[0]);
+  FrameRenderer frames(run, "osmesa", {80, 60, 0});
+  const Image tile = frames.render(0);
+  const int first = row_of_tile(plain, tile, 0);
+  ASSERT_GT(first, 20);
+  int second = -1;
+  for (int y = first + 60; second < 0 && y + 60 <= plain.height; ++y)
+    if (tile_difference(plain, tile, 16, y) < 1.0) second = y;
+  ASSERT_GT(second, first + 60);
+  EXPECT_LT(tile_difference(labelled, tile, 16, first), 1.0);  // the tiles stay where they were
+  EXPECT_LT(tile_difference(labelled, tile, 16, second), 1.0);
+  // Each row's label line changed (both read "Flock" without labels), and only those lines: the title and the
+  // captions are the same.
+  EXPECT_EQ(band_difference(plain, first, plain, second, 16), 0.0);
+  EXPECT_GT(band_difference(plain, first, labelled, first, 16), 0.5);
+  EXPECT_GT(band_difference(plain, second, labelled, second, 16), 0.5);
+  EXPECT_EQ(band_difference(plain, first - 30, labelled, first - 30, 10), 0.0);
+
+  r.labels = {"Only one"};
+  r.name = "bad";
+  EXPECT_THROW(make_figure(r), InputError);
+  EXPECT_FALSE(std::filesystem::exists(tmp.path() / "figures/bad.png"));
+}
+
 // Columns: one column per run in request order; with kLastKeyframe each run's tile is its own last keyframe
 // (here frame 3 for a flock whose only keyframe is 3, the last frame for a cloth without keyframes); with
 // several frames, time goes down.

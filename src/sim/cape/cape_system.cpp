@@ -5,16 +5,50 @@
 #include <limits>
 #include <sstream>
 
+#include "core/warnings.h"
 #include "sim/cape/anchor_track.h"
 #include "sim/character/cape_anchors.h"
 #include "sim/character/scene_character.h"
 #include "sim/make_system.h"
 
 namespace kf {
+namespace {
+
+// The cloth block lays the sheet out flat; its pinned edge then jumps to the anchors in the first step.
+// More than 10 cm is almost always a cloth block that does not match the character (the shipped capes start
+// 8 cm behind theirs, off the back).
+constexpr double kPinJumpWarning = 0.10;  // m
+
+void warn_if_pins_jump(const ClothSpec& c, const std::vector<Vec3>& anchors, const std::vector<double>& params,
+                       const std::string& where) {
+  const std::vector<Vec3> at_start = polyline_points(anchors, params);
+  const double dx = c.nx > 1 ? c.width / (c.nx - 1) : 0.0, dy = c.ny > 1 ? c.height / (c.ny - 1) : 0.0;
+  double worst = 0.0;
+  size_t worst_k = 0;
+  Vec3 worst_layout = Vec3::Zero();
+  for (size_t k = 0; k < c.pins.size(); ++k) {
+    const int i = c.pins[k] % c.nx, j = c.pins[k] / c.nx;
+    const Vec3 layout = c.origin + i * dx * c.u_axis + j * dy * c.v_axis;
+    const double d = (at_start[k] - layout).norm();
+    if (d > worst) worst = d, worst_k = k, worst_layout = layout;
+  }
+  if (worst <= kPinJumpWarning) return;
+  char msg[640];
+  const Vec3& a = at_start[worst_k];
+  std::snprintf(msg, sizeof msg,
+                "%s/anchors: the cape's pinned top edge starts up to %.3f m from its anchors and jumps to them at "
+                "frame 0 (particle %d: laid out at (%.3f, %.3f, %.3f) by cloth.origin, u_axis and v_axis, anchored at "
+                "(%.3f, %.3f, %.3f)); lay the top edge along the anchors",
+                where.c_str(), worst, c.pins[worst_k], worst_layout.x(), worst_layout.y(), worst_layout.z(), a.x(),
+                a.y(), a.z());
+  warn(msg);
+}
+
+}  // namespace
 
 
 CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, double fps, int steps, double h)
-    : spec_(character), fps_(fps), h_(h), character_(character.file, character_options(character)),
+    : spec_(character), fps_(fps), h_(h), character_(load_character(character, int(std::lround(steps * h * fps)))),
       cape_length_(cloth.height) {
   ClothSpec c = cloth;
   c.pins = named_pin_set("top_edge", c.nx, c.ny);
@@ -36,6 +70,7 @@ CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, d
     anchors.push_back(std::move(a));
   }
   auto track = std::make_unique<AnchorTrack>(anchors, c.pins, params, c.particles(), h);
+  if (character.start_x.size() == 0) warn_if_pins_jump(c, anchors[0], params, character.where);
 
   std::vector<std::unique_ptr<Collider>> extra;
   auto body = std::make_unique<BodyCollider>(character_.triangles(), character_.vertex_count(),

@@ -11,11 +11,20 @@ namespace kf {
 
 // For each target (file frame; the character's placement is applied to it), the index of the nearest
 // bind-pose vertex among the vertices of the mesh named `mesh` ("" = every mesh).
-// Throws InputError when the mesh name does not exist.
+// Throws InputError when the mesh name does not exist; `where` ("file: /pointer" of the anchors block)
+// starts the message, which lists the meshes there are.
 std::vector<int> nearest_bind_vertices(const Character& character, const std::vector<Vec3>& targets,
-                                       const std::string& mesh = "");
+                                       const std::string& mesh = "", const std::string& where = "");
 
-// nearest_bind_vertices(character, anchors.points, anchors.mesh): one vertex index per anchor point.
+// Bind-pose position of a node (file frame, before the placement): a bone's from its offset matrix, any
+// other node's from its rest transforms.
+Vec3 node_bind_position(const Character& character, int node);
+
+// The anchor points, file frame: anchors.points, or the bind-pose positions of anchors.nodes (throws
+// InputError naming anchors.where and the nodes there are when a name is missing).
+std::vector<Vec3> cape_anchor_points(const Character& character, const CapeAnchors& anchors);
+
+// nearest_bind_vertices of cape_anchor_points: one vertex index per anchor.
 std::vector<int> cape_anchor_vertices(const Character& character, const CapeAnchors& anchors);
 
 // Posed positions of `vertices` from a posed vertex array x (3n): out = 3 * vertices.size() entries.

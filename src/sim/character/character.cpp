@@ -195,7 +195,8 @@ void Character::read_meshes(const aiScene& scene, const std::unordered_map<std::
   mesh_vertex_begin_.push_back(v0);
 }
 
-Character::Character(const std::filesystem::path& file, const CharacterOptions& options) : options_(options) {
+Character::Character(const std::filesystem::path& file, const CharacterOptions& options)
+    : options_(options), file_(file.string()) {
   const std::string name = file.string();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec))

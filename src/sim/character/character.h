@@ -66,6 +66,7 @@ class Character {
   // when it is missing, unreadable, truncated, has no mesh, no bones or no animation.
   explicit Character(const std::filesystem::path& file, const CharacterOptions& options = {});
 
+  const std::string& file() const { return file_; }  // as given to the constructor, for messages
   int vertex_count() const { return static_cast<int>(bind_vertices_.size() / 3); }
   int triangle_count() const { return static_cast<int>(triangles_.rows()); }
   // Bind-pose vertices: 3n entries, metres, file frame with `placement` applied.
@@ -109,6 +110,7 @@ class Character {
   void read_meshes(const aiScene& scene, const std::unordered_map<std::string, int>& by_name, const std::string& name);
 
   CharacterOptions options_;
+  std::string file_;
   VecX raw_vertices_;   // as stored in the file (mesh frame), 3n
   VecX bind_vertices_;
   TriangleIndices triangles_;

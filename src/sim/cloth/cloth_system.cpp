@@ -217,6 +217,36 @@ double ClothSystem::external_work(const VecX& u, const VecX& x0, const VecX& x1,
   return w;
 }
 
+void ClothSystem::accept_substep(int depth, double t0, const VecX& x, const VecX& v, ClothRecord& rec) {
+  if (int(rec.substeps.size()) <= rec.count) rec.substeps.emplace_back();
+  ClothRecord::Substep& e = rec.substeps[rec.count++];
+  e.depth = depth;
+  e.t0 = t0;
+  e.dv = dv_;
+  if (depth > 0) {  // the first substep of an unsplit step starts from the step's own state
+    e.x = x;
+    e.v = v;
+  }
+}
+
+bool ClothSystem::held_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u,
+                            VecX& x_next, VecX& v_next, ClothRecord& rec, const std::vector<std::uint8_t>& pattern) {
+  if (cursor_ >= pattern.size() || pattern[cursor_] < depth) return false;  // not a pattern a run recorded
+  if (pattern[cursor_] == depth) {
+    ++cursor_;
+    if (!linear_step(n, depth, t0, x, v, u, x_next, v_next)) return false;
+    accept_substep(depth, t0, x, v, rec);
+    return true;
+  }
+  if (depth >= spec_.max_halvings) return false;
+  VecX &xm = split_x_[depth], &vm = split_v_[depth];
+  xm.resize(3 * p_);
+  vm.resize(3 * p_);
+  const double half = std::ldexp(1.0, -depth - 1);
+  return held_step(n, depth + 1, t0, x, v, u, xm, vm, rec, pattern) &&
+         held_step(n, depth + 1, t0 + half, xm, vm, u, x_next, v_next, rec, pattern);
+}
+
 bool ClothSystem::checked_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u,
                                VecX& x_next, VecX& v_next, ClothRecord& rec) {
   const bool solved = linear_step(n, depth, t0, x, v, u, x_next, v_next);
@@ -242,15 +272,7 @@ bool ClothSystem::checked_step(int n, int depth, double t0, const VecX& x, const
     if (accept && !kick) remember_energy(x_next, v_next, after);
   }
   if (accept) {
-    if (int(rec.substeps.size()) <= rec.count) rec.substeps.emplace_back();
-    ClothRecord::Substep& e = rec.substeps[rec.count++];
-    e.depth = depth;
-    e.t0 = t0;
-    e.dv = dv_;
-    if (depth > 0) {  // the first substep of an unsplit step starts from the step's own state
-      e.x = x;
-      e.v = v;
-    }
+    accept_substep(depth, t0, x, v, rec);
     return true;
   }
   if (depth >= spec_.max_halvings) return false;
@@ -267,11 +289,21 @@ bool ClothSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
   ClothRecord& rec = static_cast<ClothRecord&>(record);
   rec.count = 0;
   last_cg_ = 0;
-  const bool ok = checked_step(n, 0, 0.0, x, v, u, x_next, v_next, rec);
+  const bool held = holding_ && n < int(held_.size()) && !held_[n].empty();
+  cursor_ = 0;
+  const bool ok = held ? held_step(n, 0, 0.0, x, v, u, x_next, v_next, rec, held_[n])
+                       : checked_step(n, 0, 0.0, x, v, u, x_next, v_next, rec);
   last_substeps_ = rec.count;
   if (n >= int(step_substeps_.size())) {  // grows during the first run only
     step_substeps_.resize(n + 1, 0);
     step_cg_.resize(n + 1, 0);
+  }
+  if (!holding_) {
+    if (n >= int(recorded_.size())) recorded_.resize(n + 1);
+    auto& pattern = recorded_[n];
+    pattern.clear();  // keeps its capacity: a run after the first allocates nothing here
+    if (ok)
+      for (int k = 0; k < rec.count; ++k) pattern.push_back(std::uint8_t(rec.substeps[k].depth));
   }
   step_substeps_[n] = ok ? rec.count : 0;
   step_cg_[n] = last_cg_;

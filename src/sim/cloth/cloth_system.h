@@ -32,6 +32,7 @@
 // PCG starts from the extrapolation of the last steps' solutions when steps come in sequence (WarmStart: n
 // after n-1, n-2, n-3 forward, n after n+1, n+2, n+3 backward) and from zero otherwise, so a rollout is the
 // same function of its inputs on every run.
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -90,6 +91,18 @@ class ClothSystem final : public System {
   void save_step_context(int n, VecX& context) const override;
   void restore_step_context(int n, const VecX& context) override;
 
+  // Which steps the energy check split, and how: per step, the depths of its accepted substeps in order
+  // (one 0 for an unsplit step). A run records it unless a schedule is held. Held, each step repeats its
+  // pattern instead of checking energy (steps past the schedule's end check it), so a rollout is a smooth
+  // function of the controls: an optimiser's line search then meets no jump where a check flips.
+  using StepSchedule = std::vector<std::vector<std::uint8_t>>;
+  const StepSchedule& schedule() const { return recorded_; }
+  void hold_schedule(StepSchedule schedule) {
+    held_ = std::move(schedule);
+    holding_ = true;
+  }
+  void release_schedule() { holding_ = false; }
+
   void set_adjoint(AdjointKind kind) { adjoint_ = kind; }
   AdjointKind adjoint() const { return adjoint_; }
 
@@ -130,6 +143,11 @@ class ClothSystem final : public System {
   // Takes the (sub)step and, if it gains energy, its two halves instead; appends accepted ones to `rec`.
   bool checked_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u, VecX& x_next,
                     VecX& v_next, ClothRecord& rec);
+  // The (sub)step as the held pattern `pattern` says from its entry cursor_ on: taken whole, or halved.
+  bool held_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u, VecX& x_next,
+                 VecX& v_next, ClothRecord& rec, const std::vector<std::uint8_t>& pattern);
+  // Appends the substep just solved (dv_) to `rec`.
+  void accept_substep(int depth, double t0, const VecX& x, const VecX& v, ClothRecord& rec);
   // The adjoint of one linearised substep (see the header comment); adds its uhat to `uhat`.
   void substep_adjoint(int n, double hs, const VecX& x, const VecX& v, const VecX& dv, bool warm, const VecX& xhat1,
                        const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat);
@@ -167,6 +185,9 @@ class ClothSystem final : public System {
   VecX adj_x_, adj_v_, adj_u_;           // adjoint of one substep (walking split steps back)
   int last_substeps_ = 0;
   std::vector<int> step_substeps_, step_cg_;  // per step n of the runs so far (0: not run)
+  StepSchedule recorded_, held_;
+  bool holding_ = false;
+  std::size_t cursor_ = 0;  // the next entry of the held step's pattern
   VecX energy_x_, energy_v_;  // the state whose collider-free energy is cached_energy_
   VecX solved_x_, solved_v_;  // with explicit controls: a substep's end without the kick, which the check measures
   Energy cached_energy_;
