@@ -68,7 +68,7 @@ void NeighborGrid::search(const VecX& x, double radius, NeighborLists& out) {
 
 void NeighborGrid::size_for(int p) {
   int buckets = 16;
-  while (buckets < 2 * p) buckets *= 2;
+  while (buckets < 4 * p) buckets *= 2;
   buckets_ = buckets;
   cell_x_.assign(p, 0);
   cell_z_.assign(p, 0);

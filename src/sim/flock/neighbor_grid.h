@@ -3,15 +3,15 @@
 //
 // Cells are radius / kReach wide in x and z, so a (2 kReach + 1)^2 block of cells holds every neighbour
 // (smaller cells than the radius: fewer agents tested for each one found), and are mapped into a table of
-// ~2p buckets filled by a counting sort, so memory is linear in agents however far the flock spreads. The
-// table is the flock's bounding box of cells in row order, wrapped when the box has more cells than the
-// table (cells sharing a bucket are then told apart by their indices), so each row of the block is,
-// unwrapped, consecutive buckets: one contiguous run of agents. The agents' cells and x, z coordinates
-// are copied in bucket order, so a run reads contiguous memory, and agents are visited in that order so
-// nearby agents share cached cells. A neighbour list is ordered by cell (z, then x) and then by agent,
-// whatever the table's shape. Cost is linear in agents at bounded density. After the first search with a
-// given p nothing is allocated, except that work space and lists grow (amortised) if the flock becomes
-// denser than ever before.
+// ~4p buckets (a flock at the figures' density fits its box unwrapped) filled by a counting sort, so
+// memory is linear in agents however far the flock spreads. The table is the flock's bounding box of
+// cells in row order, wrapped when the box has more cells than the table (cells sharing a bucket are then
+// told apart by their indices), so each row of the block is, unwrapped, consecutive buckets: one
+// contiguous run of agents. The agents' cells and x, z coordinates are copied in bucket order, so a run
+// reads contiguous memory, and agents are visited in that order so nearby agents share cached cells. A
+// neighbour list is ordered by cell (z, then x) and then by agent, whatever the table's shape. Cost is
+// linear in agents at bounded density. After the first search with a given p nothing is allocated, except
+// that work space and lists grow (amortised) if the flock becomes denser than ever before.
 #include <cstdint>
 #include <span>
 #include <vector>
