@@ -51,10 +51,26 @@ ObjectiveKind parse_center_of_mass(Block& b, const ObjectiveSpec&, const Scene&)
   return CenterOfMassKeyframe{b.vec3("target")};
 }
 
+// A circle on the ground as the regular polygon through `segments` points on it, counter-clockwise in (x, z)
+// (clockwise seen from above, where z runs toward the viewer).
+std::vector<Vec2> parse_circle(Block c) {
+  const std::vector<double> center = c.numbers("center", 2, -1e6, 1e6);
+  if (center.size() != 2) c.fail("center", "expected [x, z]");
+  const double r = c.number("radius", 1e-3, 1e4);
+  const int n = c.integer("segments", 64, 3, 4096);
+  c.finish();
+  std::vector<Vec2> poly;
+  for (int i = 0; i < n; ++i)
+    poly.emplace_back(center[0] + r * std::cos(2 * M_PI * i / n), center[1] + r * std::sin(2 * M_PI * i / n));
+  return poly;
+}
+
 ObjectiveKind parse_shape(Block& b, const ObjectiveSpec&, const Scene& s) {
   if (!s.flock) b.fail("type", "\"shape\" keyframes are for flocks; use \"position\" or \"arch\" for cloth");
   ShapeKeyframe k;
-  k.polygon = b.points2("polygon", 3);
+  if (b.has("polygon") == b.has("circle"))
+    b.fail_here("expected one of \"polygon\" [[x, z], ...] or \"circle\" {\"center\": [x, z], \"radius\"}");
+  k.polygon = b.has("circle") ? parse_circle(b.child("circle")) : b.points2("polygon", 3);
   // Agents settle where the pull ends: a margin inside the edge keeps them counted inside.
   k.margin = b.number("margin", 0.1 * s.flock->avoidance.radius, 0.0, 1e4);
   Block c = b.child("coverage");

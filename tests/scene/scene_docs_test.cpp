@@ -45,7 +45,8 @@ const char* kFlock = R"({
     {"type": "position", "frame": 5, "particles": [0], "targets": [[0, 0, 0]]},
     {"type": "velocity", "frame": 5, "targets": [[0, 0, 0]]},
     {"type": "center_of_mass", "frame": 5, "target": [0, 0, 0]},
-    {"type": "shape", "frame": 10, "polygon": [[0, 0], [1, 0], [0, 1]], "coverage": {"weight": 1}}
+    {"type": "shape", "frame": 10, "polygon": [[0, 0], [1, 0], [0, 1]], "coverage": {"weight": 1}},
+    {"type": "shape", "frame": 10, "circle": {"center": [0, 0], "radius": 2, "segments": 16}}
   ],
   "controls": {"kind": "per_frame"},
   "optimizer": {"schedule": [{"substeps": 1}], "first_step": 0.5},
