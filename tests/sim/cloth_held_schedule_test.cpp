@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <memory>
 
 #include "opt/gradcheck.h"
 #include "opt/problem.h"
@@ -34,59 +35,51 @@ int split_steps(const ClothSystem::StepSchedule& s) {
   return n;
 }
 
-// Random forces of about the particles' weight: a perturbed control, not the start.
-VecX perturbed(const Problem& problem) {
-  std::srand(11);
-  return problem.initial_guess() + 0.3 * problem.control_scale() * VecX::Random(problem.size());
-}
-
-TEST(ClothHeldSchedule, RepeatsTheRunThatRecordedIt) {
+// The curtain's system and problem, simulated once, adaptively, under random forces of about the
+// particles' weight: a perturbed control, not the start.
+class ClothHeldSchedule : public ::testing::Test {
+ protected:
+  ClothHeldSchedule() {
+    std::srand(11);
+    z = problem.initial_guess() + 0.3 * problem.control_scale() * VecX::Random(problem.size());
+    adaptive = problem.evaluate(z, nullptr);
+    adaptive_end = problem.rollout().x.back();
+  }
   const Scene scene = curtain();
-  auto sys = make_system(scene);
+  std::unique_ptr<System> sys = make_system(scene);
   ClothSystem& cloth = *cloth_of(*sys);
-  Problem problem(scene, scene.time, *sys);
-  const VecX z = perturbed(problem);
-  const double adaptive = problem.evaluate(z, nullptr);
-  const VecX end = problem.rollout().x.back();
+  Problem problem{scene, scene.time, *sys};
+  VecX z, adaptive_end;
+  double adaptive = 0;
+};
+
+TEST_F(ClothHeldSchedule, RepeatsTheRunThatRecordedIt) {
   const ClothSystem::StepSchedule recorded = cloth.schedule();
   ASSERT_EQ(int(recorded.size()), scene.time.steps());
   ASSERT_GT(split_steps(recorded), 2) << "the curtain should need split steps";
   cloth.hold_schedule(recorded);
   EXPECT_EQ(problem.evaluate(z, nullptr), adaptive);
-  EXPECT_EQ(problem.rollout().x.back(), end);
+  EXPECT_EQ(problem.rollout().x.back(), adaptive_end);
   EXPECT_EQ(cloth.schedule(), recorded);  // a held run records nothing
 }
 
-TEST(ClothHeldSchedule, OverridesTheEnergyCheck) {
-  const Scene scene = curtain();
-  auto sys = make_system(scene);
-  ClothSystem& cloth = *cloth_of(*sys);
-  Problem problem(scene, scene.time, *sys);
-  const VecX z = perturbed(problem);
-  problem.evaluate(z, nullptr);
+TEST_F(ClothHeldSchedule, OverridesTheEnergyCheck) {
   ASSERT_GT(split_steps(cloth.schedule()), 2);
   // Every step held whole: no step splits, and the motion differs from the checked one.
-  const VecX checked_end = problem.rollout().x.back();
   cloth.hold_schedule(ClothSystem::StepSchedule(scene.time.steps(), std::vector<std::uint8_t>{0}));
   problem.evaluate(z, nullptr);
   for (const auto& [name, value] : sys->run_stats())
     if (name == "split_steps") EXPECT_EQ(value, 0);
-  EXPECT_GT((problem.rollout().x.back() - checked_end).norm(), 1e-9);
+  EXPECT_GT((problem.rollout().x.back() - adaptive_end).norm(), 1e-9);
   // Released, the check decides again and splits as before.
   cloth.release_schedule();
   problem.evaluate(z, nullptr);
-  EXPECT_EQ(problem.rollout().x.back(), checked_end);
+  EXPECT_EQ(problem.rollout().x.back(), adaptive_end);
 }
 
 // The exact adjoint of a held rollout is its gradient: central differences at two step sizes agree with
 // it at a perturbed control where steps are split, and no sample meets a jump.
-TEST(ClothHeldSchedule, GradientMatchesFiniteDifferencesWithSplitSteps) {
-  const Scene scene = curtain();
-  auto sys = make_system(scene);
-  ClothSystem& cloth = *cloth_of(*sys);
-  Problem problem(scene, scene.time, *sys);
-  const VecX z = perturbed(problem);
-  problem.evaluate(z, nullptr);
+TEST_F(ClothHeldSchedule, GradientMatchesFiniteDifferencesWithSplitSteps) {
   ASSERT_GT(split_steps(cloth.schedule()), 2);
   cloth.hold_schedule(cloth.schedule());
   for (const double eps : {1e-4, 3e-5}) {
@@ -102,18 +95,12 @@ TEST(ClothHeldSchedule, GradientMatchesFiniteDifferencesWithSplitSteps) {
 
 // Released, a system steps as one that never held a pattern: a run's uncontrolled motion does not depend on
 // what the optimiser evaluated before it.
-TEST(ClothHeldSchedule, ReleasedRunsAsIfNeverHeld) {
-  const Scene scene = curtain();
+TEST_F(ClothHeldSchedule, ReleasedRunsAsIfNeverHeld) {
   auto fresh = make_system(scene);
   Problem fresh_problem(scene, scene.time, *fresh);
   const double expected = fresh_problem.evaluate(fresh_problem.initial_guess(), nullptr);
   const VecX expected_end = fresh_problem.rollout().x.back();
 
-  auto sys = make_system(scene);
-  ClothSystem& cloth = *cloth_of(*sys);
-  Problem problem(scene, scene.time, *sys);
-  const VecX z = perturbed(problem);
-  problem.evaluate(z, nullptr);
   cloth.hold_schedule(cloth.schedule());
   VecX g(problem.size());
   problem.evaluate(z, &g);
