@@ -9,40 +9,6 @@
 
 namespace kf {
 
-bool polygon_contains(const std::vector<Vec2>& poly, const Vec2& q) {
-  bool inside = false;  // even-odd rule
-  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
-    const Vec2 &a = poly[i], &b = poly[j];
-    if ((a.y() > q.y()) != (b.y() > q.y()) && q.x() < (b.x() - a.x()) * (q.y() - a.y()) / (b.y() - a.y()) + a.x())
-      inside = !inside;
-  }
-  return inside;
-}
-
-Vec2 closest_point_on_boundary(const std::vector<Vec2>& poly, const Vec2& q) {
-  double best = std::numeric_limits<double>::infinity();
-  Vec2 best_p = q;
-  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
-    const Vec2 a = poly[j], e = poly[i] - poly[j];
-    const double len2 = e.squaredNorm();
-    const double t = len2 > 0 ? std::clamp((q - a).dot(e) / len2, 0.0, 1.0) : 0.0;
-    const Vec2 p = a + t * e;
-    const double d = (q - p).squaredNorm();
-    if (d < best) {
-      best = d;
-      best_p = p;
-    }
-  }
-  return best_p;
-}
-
-Vec2 closest_point_in_polygon(const std::vector<Vec2>& poly, const Vec2& q, bool* inside) {
-  const bool in = polygon_contains(poly, q);
-  if (inside) *inside = in;
-  if (in) return q;
-  return closest_point_on_boundary(poly, q);
-}
-
 namespace {
 
 // Particle indices a term applies to: the listed ones, or all.
@@ -105,7 +71,7 @@ class CenterOfMassTerm : public ObjectiveTerm {
 };
 
 // ½w Σ max(0, s(x_i) + m)² over agents, s the signed distance to the boundary of a ground region S given
-// as a polygon in (x, z) (negative inside), m the margin: agents are pulled to at least m inside. With
+// as a polygon in (x, z), holes left out (negative inside), m the margin: agents are pulled to at least m inside. With
 // m = 0 this is ½w Σ dist(x_i, S)² over agents outside. The gradient w (s + m) ∇s is continuous across the
 // boundary (∇s is the unit direction away from the closest boundary point, outward).
 // Agents into a polygon on the ground: ½w Σ s_i² with s_i the distance outside the region (plus a margin
@@ -115,9 +81,9 @@ class CenterOfMassTerm : public ObjectiveTerm {
 class ShapeTerm : public ObjectiveTerm {
  public:
   ShapeTerm(const ObjectiveSpec& s, const ShapeKeyframe& k, int p)
-      : frame_(s.frame), w_(s.weight), margin_(k.margin), ids_(members(s, p)), poly_(k.polygon),
+      : frame_(s.frame), w_(s.weight), margin_(k.margin), ids_(members(s, p)), region_(k.polygon, k.holes),
         wc_(k.coverage_weight), r2_(k.coverage_radius * k.coverage_radius), tau_(r2_ / 16),
-        samples_(k.coverage_weight > 0 ? region_samples(k.polygon, k.coverage_spacing) : std::vector<Vec2>{}),
+        samples_(k.coverage_weight > 0 ? region_samples(region_, k.coverage_spacing) : std::vector<Vec2>{}),
         d2_(ids_.size()) {}
   std::string name() const override { return "shape"; }
   int frame() const override { return frame_; }
@@ -126,7 +92,7 @@ class ShapeTerm : public ObjectiveTerm {
     for (int i : ids_) {
       const Vec2 q(x[3 * i], x[3 * i + 2]);
       bool inside = false;
-      const Vec2 c = closest_point_in_polygon(poly_, q, &inside);
+      const Vec2 c = closest_point_in_polygon(region_, q, &inside);
       Vec2 g;
       if (!inside) {
         g = q - c;  // (s + m) ∇s with s = |q - c|, m = 0; below for m > 0
@@ -137,7 +103,7 @@ class ShapeTerm : public ObjectiveTerm {
         }
       } else {
         if (margin_ <= 0) continue;
-        const Vec2 away = closest_point_on_boundary(poly_, q) - q;  // inward distance, pointing out
+        const Vec2 away = closest_point_on_boundary(region_, q) - q;  // inward distance, pointing out
         const double depth = away.norm();
         if (depth >= margin_ || depth == 0) continue;
         g = (margin_ - depth) / depth * away;
@@ -177,7 +143,7 @@ class ShapeTerm : public ObjectiveTerm {
   int frame_;
   double w_, margin_;
   std::vector<int> ids_;
-  std::vector<Vec2> poly_;
+  GroundRegion region_;  // before samples_, which are read from it
   double wc_, r2_, tau_;
   std::vector<Vec2> samples_;
   mutable std::vector<double> d2_;  // per member, reused by every sample (evaluations are sequential)
@@ -225,24 +191,6 @@ std::unique_ptr<ObjectiveTerm> make_objective_term(const ObjectiveSpec& s, int p
           [&](const ArchKeyframe& k) -> Term { return std::make_unique<ArchTerm>(s, k, particles); },
       },
       s.kind);
-}
-
-std::vector<Vec2> region_samples(const std::vector<Vec2>& polygon, double spacing) {
-  Vec2 lo = polygon.front(), hi = lo;
-  for (const Vec2& p : polygon) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  // Cell centres of a grid over the bounding box, so opposite sides are sampled alike.
-  const int nx = std::max(1, int(std::lround((hi.x() - lo.x()) / spacing))),
-            nz = std::max(1, int(std::lround((hi.y() - lo.y()) / spacing)));
-  if (double(nx) * nz > 1e5)
-    throw InputError("shape keyframe: coverage spacing " + std::to_string(spacing) + " m gives more than 100,000 samples");
-  const Vec2 start = 0.5 * (lo + hi) - 0.5 * spacing * Vec2(nx - 1, nz - 1);
-  std::vector<Vec2> out;
-  for (int j = 0; j < nz; ++j)
-    for (int i = 0; i < nx; ++i) {
-      const Vec2 q = start + spacing * Vec2(i, j);
-      if (polygon_contains(polygon, q)) out.push_back(q);
-    }
-  return out;
 }
 
 }  // namespace kf

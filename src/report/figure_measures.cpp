@@ -46,15 +46,16 @@ namespace {
 
 // Each keyframe type's measures at its frame f (x = t.x[f]), added to m.
 void shape_measures(const ShapeKeyframe& k, const VecX& x, nlohmann::json& m) {
+  const GroundRegion region(k.polygon, k.holes);
   int inside = 0;
   const int p = int(x.size() / 3);
-  for (int i = 0; i < p; ++i) inside += polygon_contains(k.polygon, Vec2(x[3 * i], x[3 * i + 2]));
+  for (int i = 0; i < p; ++i) inside += polygon_contains(region, Vec2(x[3 * i], x[3 * i + 2]));
   const auto nn = nearest_neighbour_spacing(x);
   m["inside_fraction"] = double(inside) / p;
   m["min_spacing"] = *std::min_element(nn.begin(), nn.end());
   m["median_spacing"] = median(nn);
   // Filled, not clumped: the fraction of the region's sample points with an agent within the radius.
-  const std::vector<Vec2> samples = region_samples(k.polygon, k.coverage_spacing);
+  const std::vector<Vec2> samples = region_samples(region, k.coverage_spacing);
   int covered = 0;
   for (const Vec2& q : samples) {
     bool near = false;

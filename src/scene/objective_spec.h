@@ -40,6 +40,7 @@ struct ShapeKeyframe {
   double coverage_weight = 0;
   double coverage_radius = 0;   // metres
   double coverage_spacing = 0;  // metres
+  std::vector<std::vector<Vec2>> holes;  // closed polygons inside `polygon`, left out of the region (a ring's inside)
 };
 // Cloth: particles pulled onto a cylinder (an arch).
 struct ArchKeyframe {

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/ground_region.h"
 #include "core/json_depth.h"
 #include "scene/params.h"
 
@@ -51,26 +52,64 @@ ObjectiveKind parse_center_of_mass(Block& b, const ObjectiveSpec&, const Scene&)
   return CenterOfMassKeyframe{b.vec3("target")};
 }
 
-// A circle on the ground as the regular polygon through `segments` points on it, counter-clockwise in (x, z)
-// (clockwise seen from above, where z runs toward the viewer).
-std::vector<Vec2> parse_circle(Block c) {
+// The regular polygon through `n` points on a circle on the ground, counter-clockwise in (x, z) (clockwise
+// seen from above, where z runs toward the viewer).
+std::vector<Vec2> circle_loop(const Vec2& center, double r, int n) {
+  std::vector<Vec2> poly;
+  for (int i = 0; i < n; ++i)
+    poly.push_back(center + r * Vec2(std::cos(2 * M_PI * i / n), std::sin(2 * M_PI * i / n)));
+  return poly;
+}
+
+Vec2 read_center(Block& c) {
   const std::vector<double> center = c.numbers("center", 2, -1e6, 1e6);
   if (center.size() != 2) c.fail("center", "expected [x, z]");
+  return {center[0], center[1]};
+}
+
+std::vector<Vec2> parse_circle(Block c) {
+  const Vec2 center = read_center(c);
   const double r = c.number("radius", 1e-3, 1e4);
   const int n = c.integer("segments", 64, 3, 4096);
   c.finish();
-  std::vector<Vec2> poly;
-  for (int i = 0; i < n; ++i)
-    poly.emplace_back(center[0] + r * std::cos(2 * M_PI * i / n), center[1] + r * std::sin(2 * M_PI * i / n));
-  return poly;
+  return circle_loop(center, r, n);
+}
+
+// An annulus: the outer circle, and the inner one as its hole.
+std::pair<std::vector<Vec2>, std::vector<Vec2>> parse_ring(Block c) {
+  const Vec2 center = read_center(c);
+  const double inner = c.number("inner_radius", 1e-3, 1e4);
+  const double outer = c.number("outer_radius", 1e-3, 1e4);
+  if (!(outer > inner)) c.fail("outer_radius", "expected more than \"inner_radius\"");
+  const int n = c.integer("segments", 64, 3, 4096);
+  c.finish();
+  return {circle_loop(center, outer, n), circle_loop(center, inner, n)};
+}
+
+// A loop given as "polygon" [[x, z], ...] or "circle" {...}: a shape's outline or one of its holes.
+std::vector<Vec2> parse_loop(Block& b, const std::string& also) {
+  if (b.has("polygon") + b.has("circle") + (also.empty() ? 0 : b.has(also)) != 1)
+    b.fail_here("expected one of \"polygon\" [[x, z], ...] or \"circle\" {\"center\": [x, z], \"radius\"}" +
+                (also.empty() ? std::string() : " or \"ring\" {\"center\", \"inner_radius\", \"outer_radius\"}"));
+  return b.has("circle") ? parse_circle(b.child("circle")) : b.points2("polygon", 3);
 }
 
 ObjectiveKind parse_shape(Block& b, const ObjectiveSpec&, const Scene& s) {
   if (!s.flock) b.fail("type", "\"shape\" keyframes are for flocks; use \"position\" or \"arch\" for cloth");
   ShapeKeyframe k;
-  if (b.has("polygon") == b.has("circle"))
-    b.fail_here("expected one of \"polygon\" [[x, z], ...] or \"circle\" {\"center\": [x, z], \"radius\"}");
-  k.polygon = b.has("circle") ? parse_circle(b.child("circle")) : b.points2("polygon", 3);
+  if (b.has("ring") && !b.has("polygon") && !b.has("circle")) {
+    auto [outer, inner] = parse_ring(b.child("ring"));
+    k.polygon = std::move(outer);
+    k.holes.push_back(std::move(inner));
+  } else {
+    k.polygon = parse_loop(b, "ring");
+  }
+  for (Block& hole : b.array("holes")) {
+    k.holes.push_back(parse_loop(hole, ""));
+    hole.finish();
+  }
+  if (const std::string problem = region_problem(GroundRegion(k.polygon, k.holes)); !problem.empty())
+    b.fail("holes", problem);
   // Agents settle where the pull ends: a margin inside the edge keeps them counted inside.
   k.margin = b.number("margin", 0.1 * s.flock->avoidance.radius, 0.0, 1e4);
   Block c = b.child("coverage");

@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A flock with every flock objective type, a schedule, a first step and a camera.
+// A flock with every flock objective type and shape kind, a schedule, a first step and a camera.
 std::string flock_scene(int frames, int agents) {
   return R"({
   "$schema": "scene.schema.json",
@@ -31,7 +31,9 @@ std::string flock_scene(int frames, int agents) {
     {"type": "velocity", "frame": 5, "targets": [[0, 0, 0]]},
     {"type": "center_of_mass", "frame": 5, "target": [0, 0, 0]},
     {"type": "shape", "frame": 10, "polygon": [[0, 0], [1, 0], [0, 1]], "coverage": {"weight": 1}},
-    {"type": "shape", "frame": 10, "circle": {"center": [0, 0], "radius": 2, "segments": 16}}
+    {"type": "shape", "frame": 10, "circle": {"center": [0, 0], "radius": 2, "segments": 16}},
+    {"type": "shape", "frame": 10, "ring": {"center": [0, 0], "inner_radius": 1, "outer_radius": 4, "segments": 16},
+     "holes": [{"polygon": [[2, -0.2], [2.5, -0.2], [2.5, 0.2]]}, {"circle": {"center": [-2.5, 0], "radius": 0.3}}]}
   ],
   "controls": {"kind": "per_frame"},
   "optimizer": {"schedule": [{"substeps": 1}], "first_step": 0.5},
