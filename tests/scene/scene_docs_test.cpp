@@ -66,7 +66,8 @@ std::string cloth_with_character(const std::string& anchors, const std::string& 
          (kSource / "assets/character/BCN_Epileptic.X").string() + R"(", "anchors": )" + anchors + extra + R"(},
   "objectives": [{"type": "arch", "frame": 10, "axis_point": [0, 0, 0], "radius": 1}],
   "controls": {"kind": "initial_velocity"},
-  "optimizer": {"schedule": [{"substeps": 1, "controls": {"kind": "initial_rigid_velocity"}}, {"substeps": 2}]}
+  "optimizer": {"schedule": [{"substeps": 1, "controls": {"kind": "initial_rigid_velocity"}}, {"substeps": 2}],
+                "throw_search": 64}
 })";
 }
 
