@@ -205,6 +205,8 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& file, Pa
     log->resolved = j;
     root.set_log(log);
   }
+  // The schema an editor validates the file against (scenes/scene.schema.json, from `keyframe schema`).
+  if (root.has("$schema")) root.string("$schema");
   s.seed = unsigned(root.integer("seed", 1, 0, 2'000'000'000));
   s.time = parse_time(root.child("time"));
   const bool has_flock = root.has("flock"), has_cloth = root.has("cloth");
