@@ -100,6 +100,8 @@ def scene_blend(frames, a_run, a_frame, b_run, b_frame, end_seconds, from_frame,
 
 
 def write(path, scene):
+    if path.startswith("scenes/"):  # editors validate against the schema beside the scenes
+        scene = {"$schema": "scene.schema.json", **scene}
     with open(path, "w") as f:
         json.dump(scene, f, indent=1)
         f.write("\n")

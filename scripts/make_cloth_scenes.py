@@ -9,6 +9,8 @@ import math
 
 
 def dump(path, scene):
+    if path.startswith("scenes/"):  # editors validate against the schema beside the scenes
+        scene = {"$schema": "scene.schema.json", **scene}
     with open(path, "w") as f:
         json.dump(scene, f, indent=1)
         f.write("\n")

@@ -185,6 +185,8 @@ def make(n, frames, key_frames, keyed, max_evaluations):
 
 
 def dump(path, scene):
+    if path.startswith("scenes/"):  # editors validate against the schema beside the scenes
+        scene = {"$schema": "scene.schema.json", **scene}
     # One line for each array of numbers (a target, a vector, the particle list).
     text = re.sub(r"\[\n\s*([^\[\]{}]*?)\n\s*\]",
                   lambda m: "[" + " ".join(x.strip() for x in m.group(1).split("\n")) + "]",

@@ -27,5 +27,6 @@ void add_export_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
 void add_farm_command(CLI::App& app);
 void add_inspect_command(CLI::App& app);
+void add_schema_command(CLI::App& app);
 
 }  // namespace kf

@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   add_compare_command(app);
   add_farm_command(app);
   add_inspect_command(app);
+  add_schema_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -45,11 +45,15 @@ std::string Block::describe(const Json& v) {
   return std::string(type) + " " + s;
 }
 
-bool Block::has(const std::string& key) const { return j_.contains(key); }
+bool Block::has(const std::string& key) const {
+  asked_.insert(key);
+  return j_.contains(key);
+}
 
 void Block::note(const std::string& key, ParamRead r) {
   if (!log_) return;
   r.pointer = pointer(key);
+  if (asked_.count(key)) r.required = false;
   if (!j_.contains(key) && !r.default_value.is_null()) log_->resolved[Json::json_pointer(r.pointer)] = r.default_value;
   log_->reads.push_back(std::move(r));
 }

@@ -20,7 +20,7 @@ using Json = nlohmann::json;
 struct ParamRead {
   std::string pointer;  // JSON pointer of the key, array indices included: "/objectives/0/weight"
   std::string type;     // number, integer, boolean, string, vec3, points2, points3, numbers, integers, object, array
-  bool required = false;
+  bool required = false;  // false for a key the parser first asked about with has(): read only when present
   Json default_value;   // used when the key is absent (null: required, or no default)
   double lo = 0, hi = 0;  // range of the value, or of each of its numbers
   int min_count = 0;      // lists: at least this many entries
@@ -38,6 +38,7 @@ class Block {
   // `file` is used in messages only; `pointer` is the JSON pointer of `j` ("" for the root).
   Block(const Json& j, std::string file, std::string pointer = "");
 
+  // Whether the key is present. A key asked about is optional: its read is logged as not required.
   bool has(const std::string& key) const;
   double number(const std::string& key, double def, double lo, double hi);
   double number(const std::string& key, double lo, double hi);  // required
@@ -85,6 +86,7 @@ class Block {
   Json j_;
   std::string file_, pointer_;
   std::set<std::string> read_;
+  mutable std::set<std::string> asked_;  // keys has() was asked about
   ParamLog* log_ = nullptr;
 };
 

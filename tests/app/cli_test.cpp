@@ -47,7 +47,8 @@ class Cli : public ::testing::Test {
 // The subcommands a user can reach. A subcommand added to the CLI and not here fails this test, as does one
 // listed here that --help does not show or whose own --help fails.
 const std::vector<std::string> kSubcommands = {"simulate", "optimize", "run",    "render",  "gradcheck", "figure",
-                                               "bench",    "clip",     "export", "compare", "farm",     "inspect"};
+                                               "bench",    "clip",     "export", "compare", "farm",     "inspect",
+                                               "schema"};
 
 TEST_F(Cli, HelpListsEverySubcommand) {
   const Result r = run("--help", dir_);

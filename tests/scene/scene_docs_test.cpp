@@ -18,9 +18,9 @@
 
 #include <unistd.h>
 
-#include "core/trajectory.h"
 #include "scene/params.h"
 #include "scene/scene.h"
+#include "scene/scene_schema.h"
 
 namespace kf {
 namespace {
@@ -36,61 +36,11 @@ std::string read_text(const fs::path& p) {
   return os.str();
 }
 
-// A flock scene with every flock objective type, a schedule, a first step and a camera.
-const char* kFlock = R"({
-  "seed": 3,
-  "time": {"fps": 30, "substeps": 1, "frames": 10},
-  "flock": {"agents": 4},
-  "objectives": [
-    {"type": "position", "frame": 5, "particles": [0], "targets": [[0, 0, 0]]},
-    {"type": "velocity", "frame": 5, "targets": [[0, 0, 0]]},
-    {"type": "center_of_mass", "frame": 5, "target": [0, 0, 0]},
-    {"type": "shape", "frame": 10, "polygon": [[0, 0], [1, 0], [0, 1]], "coverage": {"weight": 1}},
-    {"type": "shape", "frame": 10, "circle": {"center": [0, 0], "radius": 2, "segments": 16}}
-  ],
-  "controls": {"kind": "per_frame"},
-  "optimizer": {"schedule": [{"substeps": 1}], "first_step": 0.5},
-  "render": {"camera": {"eye": [0, 5, 5], "target": [0, 0, 0]}}
-})";
-
-// A cape with every collider shape, node anchors, root motion, a start and an end target from a run, an arch
-// keyframe and a schedule whose first stage has its own controls. `pins` and `anchors` are the
-// alternatives the second cloth scene takes the other way.
-std::string cloth_with_character(const std::string& anchors, const std::string& extra) {
-  return R"({
-  "time": {"frames": 10},
-  "cloth": {"nx": 3, "ny": 3, "pins": )" +
-         std::string(anchors.find("nodes") != std::string::npos ? R"("top_edge")" : "[0, 1]") + R"(,
-    "colliders": [{"type": "ground"}, {"type": "sphere"}, {"type": "torus"}, {"type": "capsule"}]},
-  "character": {"file": ")" +
-         (kSource / "assets/character/BCN_Epileptic.X").string() + R"(", "anchors": )" + anchors + extra + R"(},
-  "objectives": [{"type": "arch", "frame": 10, "axis_point": [0, 0, 0], "radius": 1}],
-  "controls": {"kind": "initial_velocity"},
-  "optimizer": {"schedule": [{"substeps": 1, "controls": {"kind": "initial_rigid_velocity"}}, {"substeps": 2}]}
-})";
-}
-
-// Every key read (JSON pointers with array indices) over the scenes above; runs for the character's start
-// and end target are written into `dir`.
+// Every key read (JSON pointers with array indices) over the example scenes the schema is generated from
+// (src/scene/scene_schema.h), which enter every branch of the parser.
 std::vector<ParamRead> reads_of_every_branch(const fs::path& dir) {
-  Trajectory t;
-  t.particles = 9;
-  for (int f = 0; f < 2; ++f) t.x.push_back(VecX::Zero(27)), t.v.push_back(VecX::Zero(27));
-  fs::create_directories(dir / "run");
-  save_trajectory(dir / "run/trajectory.bin", t);
-  const std::vector<std::string> scenes = {
-      kFlock,
-      cloth_with_character(R"({"nodes": ["B_Clavicle_Left", "B_Clavicle_Right"]})",
-                           R"(, "time": [[0, 0], [10, 0.3]], "root": {"keys": [{"frame": 0}]},
-                              "start": {"run": "run", "frame": 0}, "end_target": {"run": "run", "frame": 1})"),
-      cloth_with_character(R"({"mesh": "Torso", "points": [[0, 0, 0], [1, 0, 0]]})", ""),
-  };
   std::vector<ParamRead> reads;
-  for (const std::string& text : scenes) {
-    ParamLog log;
-    parse_scene(text, dir / "scene.json", &log);
-    reads.insert(reads.end(), log.reads.begin(), log.reads.end());
-  }
+  for (const ParamLog& log : every_branch_logs(dir)) reads.insert(reads.end(), log.reads.begin(), log.reads.end());
   return reads;
 }
 
@@ -118,7 +68,7 @@ std::vector<std::string> code_spans(const std::string& line) {
 
 std::set<std::string> words_in(const std::string& text) {
   std::set<std::string> words;
-  static const std::regex word("[A-Za-z_][A-Za-z_0-9]*");
+  static const std::regex word("[$A-Za-z_][A-Za-z_0-9]*");  // "$schema" is a key
   for (std::sregex_iterator it(text.begin(), text.end(), word), end; it != end; ++it) words.insert(it->str());
   return words;
 }

@@ -26,7 +26,7 @@ FlockSystem::FlockSystem(const FlockSpec& spec, double h, int steps, unsigned se
   adjoint_.resize(spec.agents);
   if (neighbor_forces_.any()) {
     NeighborLists spawn;
-    grid_.search(spawn_positions(spec_, seed_), neighbor_forces_.radius(), spawn);
+    grid_.search_owned(spawn_positions(spec_, seed_), neighbor_forces_.radius(), spawn);
     spawn_entries_ = spawn.entries();
   }
 }
@@ -34,7 +34,7 @@ FlockSystem::FlockSystem(const FlockSpec& spec, double h, int steps, unsigned se
 std::size_t FlockSystem::record_bytes_estimate() const {
   const std::size_t p = std::size_t(spec_.agents);
   const std::size_t entries = std::max(2 * std::size_t(spawn_entries_), std::size_t(most_entries_) * 5 / 4);
-  return sizeof(int) * (p + 1 + entries) + 3 * sizeof(double) * p;
+  return sizeof(int) * (2 * p + 1 + entries) + 3 * sizeof(double) * p;
 }
 
 void FlockSystem::initial_state(VecX& x, VecX& v) const {
@@ -59,17 +59,29 @@ void FlockSystem::search(FlockRecord& r, const VecX& x, const VecX& v, bool with
     std::fill(r.b.begin(), r.b.end(), 1.0);
     return;
   }
-  grid_.search(x, neighbor_forces_.radius(), r.lists);
+  grid_.search_owned(x, neighbor_forces_.radius(), r.lists);
   most_entries_ = std::max(most_entries_, r.lists.entries());
   if (with_centering) {
     pack_motion(x, v, motion_);
-    parallel_agents(p, [&](int i) { neighbor_forces_.centering(motion_.data(), r.lists.neighbors(i), i, r.offset[i], r.b[i]); });
+    compute_forward_pairs(r);
+    parallel_agents(p, [&](int i) {
+      neighbor_forces_.gather_force(r.lists, pair_index_, forward_pairs_.data(), i, r.offset[i], r.b[i]);
+    });
   }
+}
+
+void FlockSystem::compute_forward_pairs(const FlockRecord& r) {
+  if (!neighbor_forces_.any()) return;
+  pair_index_.build(r.lists);
+  if (forward_pairs_.size() < std::size_t(pair_index_.pairs())) forward_pairs_.resize(pair_index_.pairs());
+  parallel_agents(spec_.agents, [&](int i) {
+    neighbor_forces_.forward_pairs(motion_.data(), r.lists, pair_index_, i, forward_pairs_.data());
+  });
 }
 
 void FlockSystem::add_neighbor_force(FlockRecord& r, int i, Vec3& f) const {
   if (!neighbor_forces_.any()) return;
-  const Planar fn = neighbor_forces_.force(motion_.data(), r.lists.neighbors(i), i, r.offset[i], r.b[i]);
+  const Planar fn = neighbor_forces_.gather_force(r.lists, pair_index_, forward_pairs_.data(), i, r.offset[i], r.b[i]);
   f.x() += fn.x;
   f.z() += fn.z;
 }
@@ -79,6 +91,12 @@ void FlockSystem::pack_adjoint(const FlockRecord& r, const VecX& y) {
   parallel_agents(spec_.agents, [&](int i) {
     const AgentMotion& m = motion_[i];
     adjoint_[i] = {m.x, m.z, m.vx, m.vz, y[3 * i], y[3 * i + 2], r.offset[i].x, r.offset[i].z, c / r.b[i]};
+  });
+  if (!neighbor_forces_.any()) return;
+  pair_index_.build(r.lists);
+  if (transposed_pairs_.size() < std::size_t(pair_index_.pairs())) transposed_pairs_.resize(pair_index_.pairs());
+  parallel_agents(spec_.agents, [&](int j) {
+    neighbor_forces_.transposed_pairs(adjoint_.data(), r.lists, pair_index_, j, transposed_pairs_.data());
   });
 }
 
@@ -97,6 +115,7 @@ bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
   FlockRecord& r = static_cast<FlockRecord&>(record);
   search(r, x, v, false);  // the step fills the centering quantities itself
   pack_motion(x, v, motion_);
+  compute_forward_pairs(r);
   x_next.resize(dof());
   v_next.resize(dof());
   parallel_agents(spec_.agents, [&](int i) {
@@ -118,7 +137,7 @@ void FlockSystem::transpose_apply(const FlockRecord& r, int n, const VecX& x, co
   dt.setZero();
   if (neighbor_forces_.any()) {
     Planar k, d;
-    neighbor_forces_.transpose_apply(adjoint_.data(), r.lists.neighbors(j), j, k, d);
+    neighbor_forces_.gather_transposed(r.lists, pair_index_, transposed_pairs_.data(), j, k, d);
     kt = Vec3(k.x, 0, k.z);
     dt = Vec3(d.x, 0, d.z);
   }
@@ -164,6 +183,7 @@ void FlockSystem::forces(int n, const VecX& x, const VecX& v, VecX& f) {
   check_size(x, v);
   search(scratch_, x, v, false);
   pack_motion(x, v, motion_);
+  compute_forward_pairs(scratch_);
   f.resize(dof());
   parallel_agents(spec_.agents, [&](int i) {
     Vec3 fi = local_force(n, v, i);

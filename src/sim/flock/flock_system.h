@@ -4,7 +4,9 @@
 //   v1 = v + h M^-1 (f(x, v) + u),  x1 = x + h v1          (forward)
 //   s = vhat1 + h xhat1,  xhat = xhat1 + h K^T M^-1 s,  vhat = s + h D^T M^-1 s,  uhat = h M^-1 s
 // with K = df/dx, D = df/dv at (x_n, v_n) applied matrix-free. The three neighbour forces run fused in one
-// pass over each agent's list (NeighborForces); wander and drag are per-agent terms.
+// pass over each agent's list (NeighborForces), each pair's terms computed once (PairIndex) and gathered by
+// both agents in a fixed order, so results do not depend on the thread count; wander and drag are per-agent
+// terms.
 // The forward step records the neighbour lists and centering means it found (FlockRecord, the step's tape
 // entry); its adjoint reads them, so one adjoint step costs one transposed pass and no neighbour search.
 // Planar: the y components of x1, v1 and of every adjoint output are exactly zero (y of u is ignored).
@@ -15,12 +17,14 @@
 #include "sim/flock/flock_force.h"
 #include "sim/flock/neighbor_forces.h"
 #include "sim/flock/neighbor_grid.h"
+#include "sim/flock/pair_index.h"
 #include "sim/system.h"
 
 namespace kf {
 
-// What a flock step found at its state: neighbour lists and centering quantities (offset m_i - x_i in the
-// ground plane, m, and b_i; p each).
+// What a flock step found at its state: neighbour lists, each pair once under its owner
+// (NeighborGrid::search_owned), and centering quantities (offset m_i - x_i in the ground plane, m, and b_i;
+// p each).
 struct FlockRecord final : StepRecord {
   NeighborLists lists;
   std::vector<Planar> offset;
@@ -40,7 +44,7 @@ class FlockSystem final : public System {
   void initial_state(VecX& x, VecX& v) const override;
   bool planar() const override { return true; }
   std::unique_ptr<StepRecord> new_record() const override { return std::make_unique<FlockRecord>(); }
-  // Lists (4 bytes per neighbour entry and per agent) and centering quantities (24 bytes per agent). The
+  // Lists (4 bytes per neighbour entry, 8 per agent) and centering quantities (24 bytes per agent). The
   // entries are twice those at the spawn (agents bunch as they are steered), or a quarter more than the
   // most any step has found so far, whichever is larger.
   std::size_t record_bytes_estimate() const override;
@@ -62,9 +66,12 @@ class FlockSystem final : public System {
   // Fills `r` for x: neighbour search, and the centering quantities when `with_centering` (then motion_
   // holds x and v packed).
   void search(FlockRecord& r, const VecX& x, const VecX& v, bool with_centering);
-  // Forward neighbour pass over motion_ for agent i: adds the force to f, records offset_i and b_i.
+  // Each owned pair's forward terms at the state of r (motion_ packed) into forward_pairs_.
+  void compute_forward_pairs(const FlockRecord& r);
+  // Forward neighbour pass for agent i from forward_pairs_: adds the force to f, records offset_i and b_i.
   void add_neighbor_force(FlockRecord& r, int i, Vec3& f) const;
-  // Packs adjoint_ for the transposed pass at the state of r (motion_ packed), applied to y.
+  // Packs adjoint_ for the transposed pass at the state of r (motion_ packed), applied to y, and computes
+  // each owned pair's transposed terms into transposed_pairs_.
   void pack_adjoint(const FlockRecord& r, const VecX& y);
   void check_size(const VecX& x, const VecX& v) const;
   // (K^T y)_j and (D^T y)_j of all forces at the state of record r (adjoint_ packed for it).
@@ -81,6 +88,9 @@ class FlockSystem final : public System {
   NeighborGrid grid_;    // search work space, shared by all steps
   std::vector<AgentMotion> motion_;    // the state being stepped, packed (p)
   std::vector<AgentAdjoint> adjoint_;  // the same with y and the centering quantities (p)
+  PairIndex pair_index_;                // of the lists being evaluated
+  std::vector<PairForward> forward_pairs_;        // per pair (pair_index_)
+  std::vector<PairTransposed> transposed_pairs_;  // per pair
   int spawn_entries_ = 0;  // neighbour entries at the initial state
   int most_entries_ = 0;   // the most any step has found
   FlockRecord scratch_;  // forces() and apply_KT_DT

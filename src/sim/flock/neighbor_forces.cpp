@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "sim/flock/avoidance_force.h"
+#include "sim/flock/neighbor_lists.h"
+#include "sim/flock/pair_index.h"
 #include "sim/flock/parallel_agents.h"
 #include "sim/flock/smooth_kernel.h"
 
@@ -29,93 +31,149 @@ NeighborForces::NeighborForces(const FlockSpec& s)
   if (kc_ > 0) radius_ = std::max(radius_, s.centering.radius);
 }
 
-Planar NeighborForces::force(const AgentMotion* a, std::span<const int> nbrs, int i, Planar& offset_i,
-                             double& b_i) const {
-  const AgentMotion ai = a[i];
-  double fax = 0, faz = 0, fmx = 0, fmz = 0, cx = 0, cz = 0, b = 1.0;
-  for (int j : nbrs) {
-    const AgentMotion& aj = a[j];
-    const double dx = ai.x - aj.x, dz = ai.z - aj.z;  // x_i - x_j
-    const double r2 = dx * dx + dz * dz;
-    if (r2 < ra2_) {  // avoidance: w g d
-      const KernelWeight k = smooth_kernel_inv(r2, inv_ra2_);
-      const double wg = k.w / std::sqrt(r2 + eps2_);
-      fax += wg * dx;
-      faz += wg * dz;
-    }
-    if (r2 < rm2_) {  // matching: w (v_j - v_i)
-      const double w = smooth_kernel_inv(r2, inv_rm2_).w;
-      fmx += w * (aj.vx - ai.vx);
-      fmz += w * (aj.vz - ai.vz);
-    }
-    if (r2 < rc2_) {  // centering sums: a -= w d, b += w
-      const double w = smooth_kernel_inv(r2, inv_rc2_).w;
-      cx -= w * dx;
-      cz -= w * dz;
-      b += w;
-    }
+// d = x_i - x_j. The branches skip terms out of reach (their kernel weight is zero there anyway).
+inline PairForward NeighborForces::forward_pair(const AgentMotion& ai, const AgentMotion& aj) const {
+  PairForward q;
+  const double dx = ai.x - aj.x, dz = ai.z - aj.z;
+  const double r2 = dx * dx + dz * dz;
+  if (r2 < ra2_) {  // avoidance: w g d
+    const KernelWeight k = smooth_kernel_inv(r2, inv_ra2_);
+    const double wg = k.w / std::sqrt(r2 + eps2_);
+    q.ax = wg * dx;
+    q.az = wg * dz;
   }
-  offset_i = {cx / b, cz / b};
-  b_i = b;
-  return {ka_ * fax + kmatch_ * fmx + kc_ * offset_i.x, ka_ * faz + kmatch_ * fmz + kc_ * offset_i.z};
+  if (r2 < rm2_) {  // matching: w (v_j - v_i)
+    const double w = smooth_kernel_inv(r2, inv_rm2_).w;
+    q.mx = w * (aj.vx - ai.vx);
+    q.mz = w * (aj.vz - ai.vz);
+  }
+  if (r2 < rc2_) {  // centering sums: a -= w d, b += w
+    const double w = smooth_kernel_inv(r2, inv_rc2_).w;
+    q.cx = w * dx;
+    q.cz = w * dz;
+    q.w = w;
+  }
+  return q;
 }
 
-void NeighborForces::centering(const AgentMotion* a, std::span<const int> nbrs, int i, Planar& offset_i,
-                               double& b_i) const {
-  const AgentMotion ai = a[i];
-  double cx = 0, cz = 0, b = 1.0;
-  for (int j : nbrs) {
-    const double dx = ai.x - a[j].x, dz = ai.z - a[j].z;
-    const double r2 = dx * dx + dz * dz;
-    if (r2 < rc2_) {
-      const double w = smooth_kernel_inv(r2, inv_rc2_).w;
-      cx -= w * dx;
-      cz -= w * dz;
-      b += w;
-    }
+// d = x_j - x_i.
+inline PairTransposed NeighborForces::transposed_pair(const AgentAdjoint& aj, const AgentAdjoint& ai) const {
+  PairTransposed q;
+  const double dx = aj.x - ai.x, dz = aj.z - ai.z;
+  const double r2 = dx * dx + dz * dz;
+  if (r2 < ra2_) {
+    // J(d) e with e = y_j - y_i: J = w g I + 2 (w' g + w g') d d^T, g = (r2 + eps^2)^-1/2.
+    const KernelWeight k = smooth_kernel_inv(r2, inv_ra2_);
+    const double g = 1.0 / std::sqrt(r2 + eps2_);
+    const double ex = aj.yx - ai.yx, ez = aj.yz - ai.yz;
+    const double wg = k.w * g, s = 2.0 * (k.dw_dr2 * g - 0.5 * k.w * g * g * g) * (dx * ex + dz * ez);
+    q.kax = wg * ex + s * dx;
+    q.kaz = wg * ez + s * dz;
   }
-  offset_i = {cx / b, cz / b};
-  b_i = b;
+  if (r2 < rm2_) {
+    // K^T: 2 w' ((v_i - v_j) . (y_j - y_i)) d;  D^T: w (y_i - y_j).
+    const KernelWeight k = smooth_kernel_inv(r2, inv_rm2_);
+    const double s = 2.0 * k.dw_dr2 * ((ai.vx - aj.vx) * (aj.yx - ai.yx) + (ai.vz - aj.vz) * (aj.yz - ai.yz));
+    q.kmx = s * dx;
+    q.kmz = s * dz;
+    q.dmx = k.w * (ai.yx - aj.yx);
+    q.dmz = k.w * (ai.yz - aj.yz);
+  }
+  if (r2 < rc2_) {
+    // (d f_i/d x_j)^T y_i - (d f_j/d x_i)^T y_j with g_i = -2 w' d (CenteringPair::add_KT).
+    const KernelWeight k = smooth_kernel_inv(r2, inv_rc2_);
+    const double gx = -2.0 * k.dw_dr2 * dx, gz = -2.0 * k.dw_dr2 * dz;
+    const double si = (ai.ox - dx) * ai.yx + (ai.oz - dz) * ai.yz;
+    const double sj = (dx + aj.ox) * aj.yx + (dz + aj.oz) * aj.yz;
+    q.kcx = ai.c_over_b * (k.w * ai.yx + si * gx) - aj.c_over_b * (k.w * aj.yx - sj * gx);
+    q.kcz = ai.c_over_b * (k.w * ai.yz + si * gz) - aj.c_over_b * (k.w * aj.yz - sj * gz);
+  }
+  return q;
+}
+
+namespace {
+
+// Running sums of one agent's pair terms. The centering sum a_i is kept in (cx, cz) with the sign of
+// PairForward (subtracted), b starts at the agent's own weight 1.
+struct ForwardSum {
+  PairForward s{0, 0, 0, 0, 0, 0, 1.0};
+  void add(const PairForward& q) {
+    s.ax += q.ax, s.az += q.az, s.mx += q.mx, s.mz += q.mz, s.cx -= q.cx, s.cz -= q.cz, s.w += q.w;
+  }
+  void add_mirrored(const PairForward& q) {
+    s.ax -= q.ax, s.az -= q.az, s.mx -= q.mx, s.mz -= q.mz, s.cx += q.cx, s.cz += q.cz, s.w += q.w;
+  }
+};
+
+struct TransposedSum {
+  PairTransposed s;
+  void add(const PairTransposed& q) {
+    s.kax += q.kax, s.kaz += q.kaz, s.kmx += q.kmx, s.kmz += q.kmz;
+    s.dmx += q.dmx, s.dmz += q.dmz, s.kcx += q.kcx, s.kcz += q.kcz;
+  }
+  void add_mirrored(const PairTransposed& q) {
+    s.kax -= q.kax, s.kaz -= q.kaz, s.kmx -= q.kmx, s.kmz -= q.kmz;
+    s.dmx -= q.dmx, s.dmz -= q.dmz, s.kcx -= q.kcx, s.kcz -= q.kcz;
+  }
+};
+
+// Agent i's pair terms in the order of its whole list: those of pairs earlier agents own (mirrored), then
+// its own (slots owned.start(i)...).
+template <class Sum, class Pair>
+void gather_pairs(const NeighborLists& owned, const PairIndex& index, const Pair* pairs, int i, Sum& sum) {
+  for (int k : index.mirrored(i)) sum.add_mirrored(pairs[k]);
+  for (int k = owned.start(i), end = owned.start(i + 1); k < end; ++k) sum.add(pairs[k]);
+}
+
+}  // namespace
+
+Planar NeighborForces::finish_force(const PairForward& sum, Planar& offset_i, double& b_i) const {
+  offset_i = {sum.cx / sum.w, sum.cz / sum.w};
+  b_i = sum.w;
+  return {ka_ * sum.ax + kmatch_ * sum.mx + kc_ * offset_i.x, ka_ * sum.az + kmatch_ * sum.mz + kc_ * offset_i.z};
+}
+
+void NeighborForces::finish_transposed(const PairTransposed& sum, Planar& kt, Planar& dt) const {
+  kt = {ka_ * sum.kax + kmatch_ * sum.kmx + sum.kcx, ka_ * sum.kaz + kmatch_ * sum.kmz + sum.kcz};
+  dt = {kmatch_ * sum.dmx, kmatch_ * sum.dmz};
+}
+
+Planar NeighborForces::force(const AgentMotion* a, std::span<const int> nbrs, int i, Planar& offset_i,
+                             double& b_i) const {
+  ForwardSum sum;
+  for (int j : nbrs) sum.add(forward_pair(a[i], a[j]));
+  return finish_force(sum.s, offset_i, b_i);
 }
 
 void NeighborForces::transpose_apply(const AgentAdjoint* a, std::span<const int> nbrs, int j, Planar& kt,
                                      Planar& dt) const {
-  const AgentAdjoint aj = a[j];
-  double kax = 0, kaz = 0, kmx = 0, kmz = 0, kcx = 0, kcz = 0, dmx = 0, dmz = 0;
-  for (int i : nbrs) {
-    const AgentAdjoint& ai = a[i];
-    const double dx = aj.x - ai.x, dz = aj.z - ai.z;  // x_j - x_i
-    const double r2 = dx * dx + dz * dz;
-    if (r2 < ra2_) {
-      // J(d) e with e = y_j - y_i: J = w g I + 2 (w' g + w g') d d^T, g = (r2 + eps^2)^-1/2.
-      const KernelWeight k = smooth_kernel_inv(r2, inv_ra2_);
-      const double g = 1.0 / std::sqrt(r2 + eps2_);
-      const double ex = aj.yx - ai.yx, ez = aj.yz - ai.yz;
-      const double wg = k.w * g, s = 2.0 * (k.dw_dr2 * g - 0.5 * k.w * g * g * g) * (dx * ex + dz * ez);
-      kax += wg * ex + s * dx;
-      kaz += wg * ez + s * dz;
-    }
-    if (r2 < rm2_) {
-      // K^T: 2 w' ((v_i - v_j) . (y_j - y_i)) d;  D^T: w (y_i - y_j).
-      const KernelWeight k = smooth_kernel_inv(r2, inv_rm2_);
-      const double s = 2.0 * k.dw_dr2 * ((ai.vx - aj.vx) * (aj.yx - ai.yx) + (ai.vz - aj.vz) * (aj.yz - ai.yz));
-      kmx += s * dx;
-      kmz += s * dz;
-      dmx += k.w * (ai.yx - aj.yx);
-      dmz += k.w * (ai.yz - aj.yz);
-    }
-    if (r2 < rc2_) {
-      // (d f_i/d x_j)^T y_i - (d f_j/d x_i)^T y_j with g_i = -2 w' d (CenteringPair::add_KT).
-      const KernelWeight k = smooth_kernel_inv(r2, inv_rc2_);
-      const double gx = -2.0 * k.dw_dr2 * dx, gz = -2.0 * k.dw_dr2 * dz;
-      const double si = (ai.ox - dx) * ai.yx + (ai.oz - dz) * ai.yz;
-      const double sj = (dx + aj.ox) * aj.yx + (dz + aj.oz) * aj.yz;
-      kcx += ai.c_over_b * (k.w * ai.yx + si * gx) - aj.c_over_b * (k.w * aj.yx - sj * gx);
-      kcz += ai.c_over_b * (k.w * ai.yz + si * gz) - aj.c_over_b * (k.w * aj.yz - sj * gz);
-    }
-  }
-  kt = {ka_ * kax + kmatch_ * kmx + kcx, ka_ * kaz + kmatch_ * kmz + kcz};
-  dt = {kmatch_ * dmx, kmatch_ * dmz};
+  TransposedSum sum;
+  for (int i : nbrs) sum.add(transposed_pair(a[j], a[i]));
+  finish_transposed(sum.s, kt, dt);
+}
+
+void NeighborForces::forward_pairs(const AgentMotion* a, const NeighborLists& l, const PairIndex& index, int i,
+                                   PairForward* pairs) const {
+  for (int k = l.start(i), end = l.start(i + 1); k < end; ++k) pairs[k] = forward_pair(a[i], a[l.entry(k)]);
+}
+
+Planar NeighborForces::gather_force(const NeighborLists& l, const PairIndex& index, const PairForward* pairs, int i,
+                                    Planar& offset_i, double& b_i) const {
+  ForwardSum sum;
+  gather_pairs(l, index, pairs, i, sum);
+  return finish_force(sum.s, offset_i, b_i);
+}
+
+void NeighborForces::transposed_pairs(const AgentAdjoint* a, const NeighborLists& l, const PairIndex& index, int j,
+                                      PairTransposed* pairs) const {
+  for (int k = l.start(j), end = l.start(j + 1); k < end; ++k) pairs[k] = transposed_pair(a[j], a[l.entry(k)]);
+}
+
+void NeighborForces::gather_transposed(const NeighborLists& l, const PairIndex& index, const PairTransposed* pairs,
+                                       int j, Planar& kt, Planar& dt) const {
+  TransposedSum sum;
+  gather_pairs(l, index, pairs, j, sum);
+  finish_transposed(sum.s, kt, dt);
 }
 
 void pack_motion(const VecX& x, const VecX& v, std::vector<AgentMotion>& a) {

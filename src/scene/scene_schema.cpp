@@ -1,0 +1,236 @@
+#include "scene/scene_schema.h"
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "core/trajectory.h"
+#include "scene/scene.h"
+
+namespace kf {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A flock with every flock objective type, a schedule, a first step and a camera.
+std::string flock_scene(int frames, int agents) {
+  return R"({
+  "$schema": "scene.schema.json",
+  "seed": 3,
+  "time": {"fps": 30, "substeps": 1, "frames": )" +
+         std::to_string(frames) + R"(},
+  "flock": {"agents": )" +
+         std::to_string(agents) + R"(},
+  "objectives": [
+    {"type": "position", "frame": 5, "particles": [0], "targets": [[0, 0, 0]]},
+    {"type": "velocity", "frame": 5, "targets": [[0, 0, 0]]},
+    {"type": "center_of_mass", "frame": 5, "target": [0, 0, 0]},
+    {"type": "shape", "frame": 10, "polygon": [[0, 0], [1, 0], [0, 1]], "coverage": {"weight": 1}},
+    {"type": "shape", "frame": 10, "circle": {"center": [0, 0], "radius": 2, "segments": 16}}
+  ],
+  "controls": {"kind": "per_frame"},
+  "optimizer": {"schedule": [{"substeps": 1}], "first_step": 0.5},
+  "render": {"camera": {"eye": [0, 5, 5], "target": [0, 0, 0]}}
+})";
+}
+
+// A cape with every collider shape, an arch keyframe and a schedule whose first stage has its own controls.
+// `pins` and `anchors` are the alternatives the second cape takes the other way.
+std::string cape_scene(int frames, int n, const std::string& anchors, const std::string& extra) {
+  const bool nodes = anchors.find("nodes") != std::string::npos;
+  return R"({
+  "time": {"frames": )" +
+         std::to_string(frames) + R"(},
+  "cloth": {"nx": )" + std::to_string(n) +
+         R"(, "ny": )" + std::to_string(n) + R"(, "pins": )" + (nodes ? R"("top_edge")" : "[0, 1]") + R"(,
+    "colliders": [{"type": "ground"}, {"type": "sphere"}, {"type": "torus"}, {"type": "capsule"}]},
+  "character": {"file": "character.x", "anchors": )" +
+         anchors + extra + R"(},
+  "objectives": [{"type": "arch", "frame": 10, "axis_point": [0, 0, 0], "radius": 1}],
+  "controls": {"kind": "initial_velocity"},
+  "optimizer": {"schedule": [{"substeps": 1, "controls": {"kind": "initial_rigid_velocity"}}, {"substeps": 2}],
+                "throw_search": 64}
+})";
+}
+
+}  // namespace
+
+std::vector<ParamLog> every_branch_logs(const fs::path& scratch) {
+  fs::create_directories(scratch);
+  // Parsing only checks that the character's file exists; its meshes and nodes are read when simulating.
+  std::ofstream(scratch / "character.x") << "xof 0303txt 0032\n";
+  struct Size {
+    int frames, agents, cloth_n;
+  };
+  std::vector<ParamLog> logs;
+  for (const Size z : {Size{10, 4, 3}, Size{12, 5, 4}}) {
+    // A run of the cape's particle count for the character's start and end target to read.
+    const std::string run = "run_" + std::to_string(z.cloth_n);
+    Trajectory t;
+    t.particles = z.cloth_n * z.cloth_n;
+    for (int f = 0; f < 2; ++f) t.x.push_back(VecX::Zero(3 * t.particles)), t.v.push_back(VecX::Zero(3 * t.particles));
+    fs::create_directories(scratch / run);
+    save_trajectory(scratch / run / "trajectory.bin", t);
+    const std::vector<std::string> texts = {
+        flock_scene(z.frames, z.agents),
+        cape_scene(z.frames, z.cloth_n, R"({"nodes": ["B_Clavicle_Left", "B_Clavicle_Right"]})",
+                   R"(, "time": [[0, 0], [10, 0.3]], "root": {"keys": [{"frame": 0}]},
+                      "start": {"run": ")" + run + R"(", "frame": 0}, "end_target": {"run": ")" + run +
+                       R"(", "frame": 1})"),
+        cape_scene(z.frames, z.cloth_n, R"({"mesh": "Torso", "points": [[0, 0, 0], [1, 0, 0]]})", ""),
+    };
+    for (const std::string& text : texts) {
+      ParamLog log;
+      parse_scene(text, scratch / "scene.json", &log);
+      logs.push_back(std::move(log));
+    }
+  }
+  return logs;
+}
+
+namespace {
+
+// A key (or the root) with every read of it, merged over the logs. Array elements are the child "*".
+struct KeyNode {
+  std::vector<ParamRead> reads;
+  std::set<std::string> instances;    // "log#pointer" of each object this node was, where keys were read below it
+  std::set<std::string> required_in;  // "log#pointer" of each parent object that read this key as required
+  std::map<std::string, KeyNode> keys;
+};
+
+void insert(KeyNode& root, const ParamRead& r, size_t log) {
+  const std::string tag = std::to_string(log) + "#";
+  KeyNode* node = &root;
+  std::string concrete;
+  node->instances.insert(tag);
+  std::stringstream ss(r.pointer.substr(1));
+  std::vector<std::string> parts;
+  for (std::string part; std::getline(ss, part, '/');) parts.push_back(part);
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const std::string& part = parts[i];
+    const bool index = !part.empty() && std::all_of(part.begin(), part.end(), ::isdigit);
+    const std::string parent = concrete;
+    concrete += "/" + part;
+    // Pointers escape '~' and '/' (RFC 6901); schema property names are the keys themselves.
+    std::string key = part;
+    for (size_t p; (p = key.find("~1")) != std::string::npos;) key.replace(p, 2, "/");
+    for (size_t p; (p = key.find("~0")) != std::string::npos;) key.replace(p, 2, "~");
+    node = &node->keys[index ? "*" : key];
+    if (i + 1 < parts.size()) {
+      node->instances.insert(tag + concrete);
+      continue;
+    }
+    node->reads.push_back(r);
+    if (r.required) node->required_in.insert(tag + parent);
+  }
+}
+
+Json object_schema(const KeyNode& n);
+
+// A bound every read agrees on, as the JSON number of the key's type; null when reads disagree (it follows
+// the scene, such as a keyframe's frame within the scene's frames).
+Json agreed(const std::vector<const ParamRead*>& reads, double ParamRead::*bound, bool integer) {
+  const double v = reads.front()->*bound;
+  for (const ParamRead* r : reads)
+    if (r->*bound != v) return nullptr;
+  return integer ? Json(static_cast<long long>(v)) : Json(v);
+}
+
+// {"type": "number", "minimum", "maximum"} from the reads' range, for a value or each number of a list.
+Json scalar_schema(const char* type, const std::vector<const ParamRead*>& reads) {
+  Json s = {{"type", type}};
+  const bool integer = std::string(type) == "integer";
+  if (Json lo = agreed(reads, &ParamRead::lo, integer); !lo.is_null()) s["minimum"] = lo;
+  if (Json hi = agreed(reads, &ParamRead::hi, integer); !hi.is_null()) s["maximum"] = hi;
+  return s;
+}
+
+Json list_of(Json items, int min_count, int max_count = 0) {
+  Json s = {{"type", "array"}, {"items", std::move(items)}};
+  if (min_count > 0) s["minItems"] = min_count;
+  if (max_count > 0) s["maxItems"] = max_count;
+  return s;
+}
+
+// The schema of one type a key was read as.
+Json typed_schema(const std::string& type, const std::vector<const ParamRead*>& reads, const KeyNode& n) {
+  int min_count = reads.front()->min_count;
+  for (const ParamRead* r : reads) min_count = std::min(min_count, r->min_count);
+  Json s;
+  if (type == "object") s = object_schema(n);
+  else if (type == "array") s = list_of(object_schema(n.keys.at("*")), min_count);
+  else if (type == "number" || type == "integer") s = scalar_schema(type.c_str(), reads);
+  else if (type == "boolean") s = {{"type", "boolean"}};
+  else if (type == "string" || type == "strings") {
+    Json str = {{"type", "string"}};
+    std::vector<std::string> choices;
+    for (const ParamRead* r : reads)
+      for (const std::string& c : r->choices)
+        if (std::find(choices.begin(), choices.end(), c) == choices.end()) choices.push_back(c);
+    if (!choices.empty()) str["enum"] = choices;
+    s = type == "string" ? str : list_of(str, min_count);
+  } else if (type == "vec3") s = list_of(scalar_schema("number", reads), 3, 3);
+  else if (type == "numbers") s = list_of(scalar_schema("number", reads), min_count);
+  else if (type == "integers") s = list_of(scalar_schema("integer", reads), min_count);
+  else if (type == "points2") s = list_of(list_of(scalar_schema("number", reads), 2, 2), min_count);
+  else if (type == "points3") s = list_of(list_of(scalar_schema("number", reads), 3, 3), min_count);
+  else throw std::logic_error("scene schema: no schema for the read type \"" + type + "\"");
+  const Json& def = reads.front()->default_value;
+  const bool same_default =
+      std::all_of(reads.begin(), reads.end(), [&](const ParamRead* r) { return r->default_value == def; });
+  if (!def.is_null() && same_default) s["default"] = def;
+  return s;
+}
+
+// A key read as one type, or as several (cloth "pins": a named set or indices) as anyOf.
+Json key_schema(const KeyNode& n) {
+  std::vector<std::string> types;
+  std::map<std::string, std::vector<const ParamRead*>> by_type;
+  for (const ParamRead& r : n.reads) {
+    if (!by_type.count(r.type)) types.push_back(r.type);
+    by_type[r.type].push_back(&r);
+  }
+  if (types.size() == 1) return typed_schema(types.front(), by_type[types.front()], n);
+  Json any = Json::array();
+  for (const std::string& t : types) any.push_back(typed_schema(t, by_type[t], n));
+  return {{"anyOf", any}};
+}
+
+Json object_schema(const KeyNode& n) {
+  Json s = {{"type", "object"}, {"additionalProperties", false}};
+  Json properties = Json::object(), required = Json::array();
+  for (const auto& [key, child] : n.keys) {
+    if (key == "*" || child.reads.empty()) continue;
+    properties[key] = key_schema(child);
+    const bool always_required = std::all_of(child.reads.begin(), child.reads.end(),
+                                             [](const ParamRead& r) { return r.required; });
+    if (always_required && child.required_in == n.instances) required.push_back(key);
+  }
+  s["properties"] = properties;
+  if (!required.empty()) s["required"] = required;
+  return s;
+}
+
+}  // namespace
+
+Json scene_schema(const std::vector<ParamLog>& logs) {
+  KeyNode root;
+  for (size_t i = 0; i < logs.size(); ++i)
+    for (const ParamRead& r : logs[i].reads) insert(root, r, i);
+  Json s = object_schema(root);
+  s["$schema"] = "http://json-schema.org/draft-07/schema#";
+  s["title"] = "keyframe scene";
+  s["description"] =
+      "Generated by `keyframe schema` from the keys keyframe's scene parser reads; scenes/README.md says what "
+      "each key means. The parser also checks what this schema leaves out: bounds that follow the scene (a "
+      "keyframe's frame within the scene's frames, particle indices) and rules between keys (exactly one of "
+      "\"flock\" or \"cloth\").";
+  return s;
+}
+
+}  // namespace kf
