@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <functional>
@@ -24,6 +25,7 @@
 #include "opt/diagnosis.h"
 #include "report/figure_measures.h"
 #include "opt/optimizer.h"
+#include "opt/throw_search.h"
 #include "opt/windows.h"
 #include "scene/reach_check.h"
 #include "sim/cloth/cloth_system.h"
@@ -209,6 +211,7 @@ struct JobResult {
   Diagnosis diagnosis;
   bool hold_splits = false;            // optimizer.split_schedule "held", on cloth
   ClothSystem::StepSchedule schedule;  // the split pattern the last stage held
+  nlohmann::json throw_search;         // what the search over rigid throws found (null: none ran)
 };
 
 // The rollout budget of a problem within a run's budget (bytes): what the optimiser's vectors and `held` (the
@@ -342,6 +345,7 @@ nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, size_t 
   diagnose_run(scene, job, elog, uncontrolled, final_objective, report);
   report["stage_results"] = nlohmann::json::array();
   for (const auto& st : job.stages) report["stage_results"].push_back(st.to_json());
+  if (!job.throw_search.is_null()) report["throw_search"] = job.throw_search;
   for (const auto& [name, value] : job.sys->run_stats()) report["run_stats"][name] = value;
   if (scene.character) {
     report["uncontrolled_run_stats"] = uncontrolled.stats;
@@ -507,6 +511,29 @@ bool rehold_split_schedule(JobResult& job, const VecX& z, double& phi) {
   return false;
 }
 
+// The search over rigid throws before a rigid first stage (opt/throw_search.h): every step is checked
+// while the throws differ, then the best one's split pattern is held. Deterministic, so a resume that
+// replays the run's evaluations searches again and starts where the run did.
+void search_throws_first(const JobContext& c, JobResult& job) {
+  if (ClothSystem* cloth = cloth_of(*job.sys)) cloth->release_schedule();
+  const auto t0 = std::chrono::steady_clock::now();
+  const ThrowSearch found = search_throws(*job.problem, c.plan.throw_search);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::ostringstream os;
+  os << std::setprecision(3) << "throw search: " << found.simulated << " rigid throws simulated (speeds within "
+     << found.speed << " m/s, spins within " << found.spin << " rad/s of the scene's) in " << std::fixed
+     << std::setprecision(2) << seconds << " s; " << std::scientific << std::setprecision(3);
+  if (found.phi < found.start_phi) os << "the best has objective " << found.phi << ", the scene's throw " << found.start_phi;
+  else os << "none beats the scene's throw (objective " << found.start_phi << ")";
+  c.elog.say(os.str());
+  job.throw_search = {{"throws", found.simulated}, {"speed_range", found.speed}, {"spin_range", found.spin},
+                      {"start_objective", found.start_phi}, {"best_objective", found.phi},
+                      {"best_throw", std::vector<double>(found.z.data(), found.z.data() + found.z.size())},
+                      {"seconds", seconds}};
+  job.z = found.z;
+  hold_split_schedule(job, job.z);
+}
+
 // Stage s of the coarse-to-fine continuation: its system (the first is built already), problem and optimisation.
 void run_job_stage(const JobContext& c, const std::vector<StageSpec>& stages, size_t s, JobResult& job,
                    TimeSpec& z_time) {
@@ -519,6 +546,7 @@ void run_job_stage(const JobContext& c, const std::vector<StageSpec>& stages, si
   else hold_split_schedule(job, job.z);
   Problem& problem = *job.problem;
   if (from_controls_file) check_resumed_controls(c.dir, problem, job.z);
+  if (s == 0 && c.plan.throw_search > 0 && !from_controls_file) search_throws_first(c, job);
   const int stage_id = stages.size() > 1 ? int(s) + 1 : 0;
   say_stage(c, job, stage_id);
   if (problem.checkpoint_every() == 0) c.elog.say(memory_line);

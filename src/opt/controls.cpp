@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include <Eigen/Geometry>  // cross products
+#include <Eigen/Eigenvalues>  // the sheet's principal axes
+#include <Eigen/Geometry>     // cross products
 
 namespace kf {
 
@@ -25,6 +26,64 @@ Controls::Controls(const ControlSpec& spec, const TimeSpec& time, int particles,
     arms_.resize(3 * particles_);
     for (int i = 0; i < particles_; ++i) arms_.segment<3>(3 * i) = x0_scene.segment<3>(3 * i) - c;
   }
+  if (kind_ == ControlKind::kInitialLatticeVelocity) {
+    lattice_ = true;
+    kind_ = ControlKind::kInitialVelocity;
+    lay_lattice(x0_scene);
+  }
+}
+
+void Controls::lay_lattice(const VecX& x0_scene) {
+  Vec3 c = Vec3::Zero();
+  for (int i = 0; i < particles_; ++i) c += x0_scene.segment<3>(3 * i);
+  c /= std::max(1, particles_);
+  Mat3 cov = Mat3::Zero();
+  for (int i = 0; i < particles_; ++i) {
+    const Vec3 r = x0_scene.segment<3>(3 * i) - c;
+    cov += r * r.transpose();
+  }
+  // Eigenvalues ascending: the last two columns are the sheet's plane (a crumpled start: its widest extent).
+  const Eigen::SelfAdjointEigenSolver<Mat3> eig(cov);
+  const Vec3 axes[2] = {eig.eigenvectors().col(2), eig.eigenvectors().col(1)};
+  std::vector<double> coord[2];
+  double lo[2], hi[2];
+  for (int a = 0; a < 2; ++a) {
+    coord[a].resize(particles_);
+    for (int i = 0; i < particles_; ++i) coord[a][i] = (x0_scene.segment<3>(3 * i) - c).dot(axes[a]);
+    lo[a] = particles_ ? *std::min_element(coord[a].begin(), coord[a].end()) : 0;
+    hi[a] = particles_ ? *std::max_element(coord[a].begin(), coord[a].end()) : 0;
+  }
+  constexpr int n = kLatticeSide - 1;  // cells per side
+  lattice_weights_.resize(particles_);
+  for (int i = 0; i < particles_; ++i) {
+    int cell[2];
+    double t[2];
+    for (int a = 0; a < 2; ++a) {
+      const double u = hi[a] > lo[a] ? (coord[a][i] - lo[a]) / (hi[a] - lo[a]) * n : 0.0;
+      cell[a] = std::clamp(int(u), 0, n - 1);
+      t[a] = std::clamp(u - cell[a], 0.0, 1.0);
+    }
+    const int k = cell[1] * kLatticeSide + cell[0];
+    lattice_weights_[i] = {{{k, (1 - t[0]) * (1 - t[1])},
+                            {k + 1, t[0] * (1 - t[1])},
+                            {k + kLatticeSide, (1 - t[0]) * t[1]},
+                            {k + kLatticeSide + 1, t[0] * t[1]}}};
+  }
+}
+
+void Controls::lattice_velocity(const VecX& z, VecX& v0) const {
+  const int nc = int(comps_.size());
+  v0 = v0_scene_;
+  for (int i = 0; i < particles_; ++i)
+    for (const auto& [k, w] : lattice_weights_[i])
+      for (int c = 0; c < nc; ++c) v0[3 * i + comps_[c]] += w * z[k * nc + c];
+}
+
+void Controls::lattice_gather(const VecX& dv0, VecX& dz) const {
+  const int nc = int(comps_.size());
+  for (int i = 0; i < particles_; ++i)
+    for (const auto& [k, w] : lattice_weights_[i])
+      for (int c = 0; c < nc; ++c) dz[k * nc + c] += w * dv0[3 * i + comps_[c]];
 }
 
 int Controls::block_of(int n) const {
@@ -56,7 +115,7 @@ void Controls::rigid_gather(const VecX& dv0, VecX& dz) const {
 
 VecX Controls::initial_guess() const {
   VecX z = VecX::Zero(size());
-  if (kind_ == ControlKind::kInitialVelocity && !rigid_) {
+  if (kind_ == ControlKind::kInitialVelocity && !rigid_ && !lattice_) {
     const int nc = int(comps_.size());
     for (int i = 0; i < particles_; ++i)
       for (int c = 0; c < nc; ++c) z[i * nc + c] = v0_scene_[3 * i + comps_[c]];
@@ -73,6 +132,7 @@ void Controls::expand(const VecX& z, VecX& v0, std::vector<VecX>& U) const {
   }
   v0 = v0_scene_;
   if (rigid_) return rigid_velocity(z, v0);
+  if (lattice_) return lattice_velocity(z, v0);
   if (kind_ == ControlKind::kInitialVelocity) {
     for (int i = 0; i < particles_; ++i)
       for (int c = 0; c < nc; ++c) v0[3 * i + comps_[c]] = z[i * nc + c];
@@ -89,6 +149,7 @@ void Controls::gather(const std::vector<VecX>& dU, const VecX& dv0, VecX& dz) co
   const int nc = int(comps_.size()), stride = particles_ * nc;
   dz.setZero(size());
   if (rigid_) return rigid_gather(dv0, dz);
+  if (lattice_) return lattice_gather(dv0, dz);
   if (kind_ == ControlKind::kInitialVelocity) {
     for (int i = 0; i < particles_; ++i)
       for (int c = 0; c < nc; ++c) dz[i * nc + c] = dv0[3 * i + comps_[c]];
@@ -144,15 +205,32 @@ void Controls::initial_velocity(const VecX& z, VecX& v0) const {
   v0 = v0_scene_;
   if (kind_ != ControlKind::kInitialVelocity) return;
   if (rigid_) return rigid_velocity(z, v0);
+  if (lattice_) return lattice_velocity(z, v0);
   for (int i = 0; i < particles_; ++i)
     for (int c = 0; c < nc; ++c) v0[3 * i + comps_[c]] = z[i * nc + c];
 }
 
 VecX Controls::from_initial_velocity(const VecX& v0) const {
   if (kind_ != ControlKind::kInitialVelocity || rigid_)
-    throw std::logic_error("Controls::from_initial_velocity: only for per-particle initial velocities");
+    throw std::logic_error("Controls::from_initial_velocity: only for per-particle or lattice initial velocities");
   const int nc = int(comps_.size());
   VecX z(size());
+  if (lattice_) {  // least squares: (W^T W) z_c = W^T (v0 - v0_scene)_c for each component c
+    Eigen::Matrix<double, kLatticeNodes, kLatticeNodes> normal =
+        Eigen::Matrix<double, kLatticeNodes, kLatticeNodes>::Zero();
+    Eigen::Matrix<double, kLatticeNodes, Eigen::Dynamic> rhs =
+        Eigen::Matrix<double, kLatticeNodes, Eigen::Dynamic>::Zero(kLatticeNodes, nc);
+    for (int i = 0; i < particles_; ++i)
+      for (const auto& [k, w] : lattice_weights_[i]) {
+        for (const auto& [l, wl] : lattice_weights_[i]) normal(k, l) += w * wl;
+        for (int c = 0; c < nc; ++c) rhs(k, c) += w * (v0[3 * i + comps_[c]] - v0_scene_[3 * i + comps_[c]]);
+      }
+    normal.diagonal().array() += 1e-12 * std::max(1.0, normal.trace());  // a node no particle reaches gets 0
+    const Eigen::Matrix<double, kLatticeNodes, Eigen::Dynamic> sol = normal.ldlt().solve(rhs);
+    for (int k = 0; k < kLatticeNodes; ++k)
+      for (int c = 0; c < nc; ++c) z[k * nc + c] = sol(k, c);
+    return z;
+  }
   for (int i = 0; i < particles_; ++i)
     for (int c = 0; c < nc; ++c) z[i * nc + c] = v0[3 * i + comps_[c]];
   return z;
@@ -162,6 +240,7 @@ void Controls::gather_initial_velocity(const VecX& dv0, VecX& dz) const {
   const int nc = int(comps_.size());
   if (kind_ != ControlKind::kInitialVelocity) return;
   if (rigid_) return rigid_gather(dv0, dz);
+  if (lattice_) return lattice_gather(dv0, dz);
   for (int i = 0; i < particles_; ++i)
     for (int c = 0; c < nc; ++c) dz[i * nc + c] += dv0[3 * i + comps_[c]];
 }

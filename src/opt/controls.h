@@ -1,8 +1,12 @@
 #pragma once
 // How the optimisation variables z become control forces: one force per particle per step (paper),
-// one per particle per frame held over its substeps (Stuyck ch. 8), the initial velocities only, or one
-// initial linear and angular velocity for the whole body (a thrown sheet needs six numbers, not 3p).
+// one per particle per frame held over its substeps (Stuyck ch. 8), the initial velocities only, one
+// initial linear and angular velocity for the whole body (a thrown sheet needs six numbers, not 3p), or
+// initial velocities interpolated from a 3 x 3 lattice laid over the sheet (smooth: they bend the throw
+// without exciting the stiff springs between neighbours, which per-particle velocities do).
 // Ground-bound (planar) systems get no y components.
+#include <array>
+#include <utility>
 #include <vector>
 
 #include "core/types.h"
@@ -17,7 +21,9 @@ class Controls {
   Controls(const ControlSpec& spec, const TimeSpec& time, int particles, bool planar, const VecX& x0_scene,
            const VecX& v0_scene);
 
-  int size() const { return rigid_ ? 6 : blocks_ * particles_ * int(comps_.size()); }
+  int size() const {
+    return rigid_ ? 6 : lattice_ ? kLatticeNodes * int(comps_.size()) : blocks_ * particles_ * int(comps_.size());
+  }
   const char* kind() const { return control_kind_name(name_); }
   // The starting point of the optimisation: no force, or the scene's initial velocities.
   VecX initial_guess() const;
@@ -40,8 +46,8 @@ class Controls {
   int first_step() const { return kind_ == ControlKind::kInitialVelocity ? 0 : first_step_; }
   // The initial velocities z gives (3p).
   void initial_velocity(const VecX& z, VecX& v0) const;
-  // The per-particle initial-velocity controls (size()) that give v0 (3p), e.g. a rigid throw's velocities
-  // carried into the next stage. Only for initial_velocity control.
+  // The initial-velocity controls (size()) that give v0 (3p), e.g. a rigid throw's velocities carried into
+  // the next stage: exact for per-particle controls, the least-squares fit for a lattice. Not for rigid.
   VecX from_initial_velocity(const VecX& v0) const;
   // dphi/dv0 -> dphi/dz for initial-velocity control, added into dz (nothing for force controls).
   void gather_initial_velocity(const VecX& dv0, VecX& dz) const;
@@ -64,6 +70,14 @@ class Controls {
   VecX arms_;
   void rigid_velocity(const VecX& z, VecX& v0) const;
   void rigid_gather(const VecX& dv0, VecX& dz) const;
+  // Lattice initial velocity: v0_i = v0_scene_i + Σ_k w_ik z_k, bilinear over the kLatticeSide² nodes of a
+  // grid spanning the initial sheet's two widest principal axes; each particle's four (node, weight).
+  static constexpr int kLatticeSide = 3, kLatticeNodes = kLatticeSide * kLatticeSide;
+  bool lattice_ = false;
+  std::vector<std::array<std::pair<int, double>, 4>> lattice_weights_;
+  void lay_lattice(const VecX& x0_scene);
+  void lattice_velocity(const VecX& z, VecX& v0) const;
+  void lattice_gather(const VecX& dv0, VecX& dz) const;
 };
 
 }  // namespace kf

@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "opt/throw_search.h"
 #include "sim/make_system.h"
 
 namespace kf {
@@ -86,9 +87,17 @@ StagePlan plan_stages(const Scene& scene) {
     ControlSpec rigid = c;
     rigid.kind = ControlKind::kInitialRigidVelocity;
     const int rigid_budget = std::clamp(o.max_evaluations / 3, 1, 40);
-    plan.stages = {{scene.time.substeps, rigid_budget, rigid},
-                   {scene.time.substeps, o.max_evaluations - rigid_budget, std::nullopt}};
-    plan.why = "stages: a rigid throw (6 variables), then one initial velocity per particle from it";
+    ControlSpec lattice = c;
+    lattice.kind = ControlKind::kInitialLatticeVelocity;
+    const int lattice_budget = std::clamp((o.max_evaluations - rigid_budget) / 3, 0, 60);
+    plan.stages = {{scene.time.substeps, rigid_budget, rigid}};
+    if (lattice_budget > 0) plan.stages.push_back({scene.time.substeps, lattice_budget, lattice});
+    plan.stages.push_back({scene.time.substeps, o.max_evaluations - rigid_budget - lattice_budget, std::nullopt});
+    plan.throw_search = o.throw_search >= 0 ? o.throw_search
+                                            : automatic_throw_count(scene.cloth->nx * scene.cloth->ny, scene.time.steps());
+    plan.why = "stages: a search over " + std::to_string(plan.throw_search) +
+               " rigid throws, the best rigid throw (6 variables), a 3 x 3 lattice of initial velocities over the "
+               "sheet from it, then one initial velocity per particle";
     plan.scaled_first_step = true;
     return plan;
   }

@@ -9,7 +9,9 @@
 //    windows twice, four times ... as long, down to controls.from_frame; each stage starts from the forces
 //    the last one found (new frames without force), so a longer window can only improve on it. A tame
 //    gradient (a sheet in free flight) keeps one stage.
-//  - per-particle initial velocities start from the best rigid throw (six numbers; ring-toss.json's stages).
+//  - per-particle initial velocities start from the best rigid throw (six numbers; ring-toss.json's stages),
+//    found by a search over throws and then L-BFGS, bent by a 3 x 3 lattice of velocities over the sheet
+//    (27 numbers, smooth over it) before every particle gets its own.
 // Flocks, whose gradients stay tame, run in one stage.
 #include <string>
 #include <vector>
@@ -22,6 +24,7 @@ namespace kf {
 struct StagePlan {
   std::vector<StageSpec> stages;  // at least one; the last optimises the scene's own controls
   double growth = 0;              // the force gradient's growth at the start (0: not measured)
+  int throw_search = 0;           // rigid throws simulated before the first (rigid) stage (opt/throw_search.h)
   // The strategy staged the run (windows, or a rigid throw first): an automatic optimizer.first_step is
   // then the problem's control_scale(); elsewhere it is off, and a run is as it was without strategies.
   bool scaled_first_step = false;

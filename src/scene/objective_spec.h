@@ -70,10 +70,11 @@ inline const char* type_name(const ObjectiveSpec& o) {
 }
 
 // The control parameterisation (scene key controls.kind, named as in the scene file by control_kind_name).
-enum class ControlKind { kPerStep, kPerFrame, kInitialVelocity, kInitialRigidVelocity };
+enum class ControlKind { kPerStep, kPerFrame, kInitialVelocity, kInitialRigidVelocity, kInitialLatticeVelocity };
 
 inline const char* control_kind_name(ControlKind k) {
-  constexpr const char* kNames[] = {"per_step", "per_frame", "initial_velocity", "initial_rigid_velocity"};
+  constexpr const char* kNames[] = {"per_step", "per_frame", "initial_velocity", "initial_rigid_velocity",
+                                    "initial_lattice_velocity"};
   return kNames[int(k)];
 }
 
@@ -127,6 +128,9 @@ struct OptimizerSpec {
   // RMS change per control variable of L-BFGS's first trial step (N for forces, m/s for velocities); a
   // steeper start is scaled down to it. < 0: automatic (the mean particle's weight, or 1 m/s); 0: off.
   double first_step = -1;
+  // Strategy auto, initial_velocity controls: rigid throws simulated (forward only) before the rigid
+  // stage, which starts from the best (opt/throw_search.h). < 0: automatic (automatic_throw_count); 0: off.
+  int throw_search = -1;
 };
 
 }  // namespace kf

@@ -158,11 +158,12 @@ ObjectiveSpec parse_objective(Block b, const Scene& s) {
   return o;
 }
 
-// `only_initial`: a schedule stage's controls, limited to the two initial-velocity kinds; frames: the scene's.
+// `only_initial`: a schedule stage's controls, limited to the initial-velocity kinds; frames: the scene's.
 ControlSpec parse_controls(Block b, bool only_initial = false, int frames = 1) {
   ControlSpec c;
   if (only_initial) c.kind = ControlKind::kInitialRigidVelocity;
-  std::vector<ControlKind> kinds = {ControlKind::kInitialVelocity, ControlKind::kInitialRigidVelocity};
+  std::vector<ControlKind> kinds = {ControlKind::kInitialVelocity, ControlKind::kInitialRigidVelocity,
+                                    ControlKind::kInitialLatticeVelocity};
   if (!only_initial) kinds.insert(kinds.begin(), {ControlKind::kPerStep, ControlKind::kPerFrame});
   std::vector<std::string> names;
   for (ControlKind k : kinds) names.push_back(control_kind_name(k));
@@ -172,7 +173,8 @@ ControlSpec parse_controls(Block b, bool only_initial = false, int frames = 1) {
   // Initial velocities are one control per particle, summed in the effort: at forces' 1e-4 the effort of a
   // throw outweighs a centimetre of keyframe error on a 12 x 12 sheet (throw-over-bar.json stopped 1.24 cm
   // away with the effort 99 % of its objective).
-  const bool initial = c.kind == ControlKind::kInitialVelocity || c.kind == ControlKind::kInitialRigidVelocity;
+  const bool initial = c.kind == ControlKind::kInitialVelocity || c.kind == ControlKind::kInitialRigidVelocity ||
+                       c.kind == ControlKind::kInitialLatticeVelocity;
   c.alpha = b.number("alpha", initial ? kInitialVelocityAlpha : c.alpha, 0.0, 1e6);
   if (!only_initial) c.from_frame = b.integer("from_frame", 0, 0, std::max(0, frames - 1));
   b.finish();
@@ -192,7 +194,7 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls) {
     st.substeps = stage.integer("substeps", 1, 10000);
     st.max_evaluations = stage.integer("max_evaluations", st.max_evaluations, 0, 1000000);
     if (stage.has("controls")) {
-      // Only between the two initial-velocity kinds: their controls carry over as the velocities they give,
+      // Only between the initial-velocity kinds: their controls carry over as the velocities they give,
       // and the last stage is the scene's own kind (what the run's controls.bin holds).
       if (scene_controls.kind != ControlKind::kInitialVelocity)
         stage.fail("controls", "a stage's own controls only with the scene's controls.kind \"initial_velocity\"");
@@ -205,6 +207,7 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls) {
   o.checkpoint_every = b.integer("checkpoint_every", o.checkpoint_every, 0, 10'000'000);
   o.max_memory = b.number("max_memory", o.max_memory, 0.0, 1e6);
   o.restarts = b.integer("restarts", o.restarts, 0, 1000);
+  if (b.has("throw_search")) o.throw_search = b.integer("throw_search", 0, 0, 100000);
   o.split_schedule = b.string("split_schedule", o.split_schedule, {"held", "adaptive"});
   o.adjoint = b.string("adjoint", o.adjoint, {"exact", "swap"});
   o.strategy = b.string("strategy", o.strategy, {"auto", "single"});

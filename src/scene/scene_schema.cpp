@@ -55,7 +55,8 @@ std::string cape_scene(int frames, int n, const std::string& anchors, const std:
          anchors + extra + R"(},
   "objectives": [{"type": "arch", "frame": 10, "axis_point": [0, 0, 0], "radius": 1}],
   "controls": {"kind": "initial_velocity"},
-  "optimizer": {"schedule": [{"substeps": 1, "controls": {"kind": "initial_rigid_velocity"}}, {"substeps": 2}]}
+  "optimizer": {"schedule": [{"substeps": 1, "controls": {"kind": "initial_rigid_velocity"}}, {"substeps": 2}],
+                "throw_search": 64}
 })";
 }
 

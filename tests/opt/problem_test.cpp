@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 
 #include "opt/gradcheck.h"
 #include "opt/optimizer.h"
@@ -135,6 +136,40 @@ TEST(Problem, PlanarControlsHaveNoVerticalComponent) {
   c.expand(VecX::Ones(c.size()), v0, U);
   for (const auto& u : U)
     for (int i = 0; i < 5; ++i) EXPECT_EQ(u[3 * i + 1], 0.0);
+}
+
+// A flat 5 x 4 sheet tilted out of every coordinate plane, its velocities from a 3 x 3 lattice.
+TEST(Problem, LatticeVelocitiesHoldARigidThrowExactlyAndGatherIsTheirTranspose) {
+  const Vec3 u = Vec3(1, 0.2, 0.1).normalized(), v = Vec3(-0.1, 0.3, 1).normalized();
+  VecX x0(3 * 20), v0_scene(3 * 20);
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 5; ++i) {
+      x0.segment<3>(3 * (j * 5 + i)) = Vec3(0.5, 1, -0.2) + 0.1 * i * u + 0.1 * j * v;
+      v0_scene.segment<3>(3 * (j * 5 + i)) = Vec3(0.3, -0.1, 0.2);
+    }
+  TimeSpec t;
+  ControlSpec rigid_spec, lattice_spec;
+  rigid_spec.kind = ControlKind::kInitialRigidVelocity;
+  lattice_spec.kind = ControlKind::kInitialLatticeVelocity;
+  const Controls rigid(rigid_spec, t, 20, false, x0, v0_scene), lattice(lattice_spec, t, 20, false, x0, v0_scene);
+  ASSERT_EQ(lattice.size(), 27);
+  // A rigid throw's velocities are affine over the sheet's plane: bilinear interpolation holds them exactly.
+  VecX v_rigid, v_lattice;
+  rigid.initial_velocity((VecX(6) << 0.4, 2.0, -0.7, 1.5, -0.3, 2.2).finished(), v_rigid);
+  lattice.initial_velocity(lattice.from_initial_velocity(v_rigid), v_lattice);
+  EXPECT_LT((v_lattice - v_rigid).norm(), 1e-10 * v_rigid.norm());
+  // A field that is not bilinear over the lattice's cells is not.
+  VecX v_wavy = v0_scene;
+  for (int i = 0; i < 20; ++i) v_wavy[3 * i + 1] += std::sin(7.0 * i);
+  lattice.initial_velocity(lattice.from_initial_velocity(v_wavy), v_lattice);
+  EXPECT_GT((v_lattice - v_wavy).norm(), 0.1);
+  // <W z, dv> = <z, W^T dv>: the gradient the optimiser gets is the transpose of the map it steers.
+  const VecX z = VecX::Random(27), dv = VecX::Random(60);
+  VecX v_z, dz = VecX::Zero(27);
+  std::vector<VecX> U, dU(t.steps(), VecX::Zero(60));
+  lattice.expand(z, v_z, U);
+  lattice.gather(dU, dv, dz);
+  EXPECT_NEAR((v_z - v0_scene).dot(dv), z.dot(dz), 1e-12);
 }
 
 TEST(Optimizer, ReducesTheObjectiveByOrdersOfMagnitude) {

@@ -6,9 +6,11 @@
 
 #include "opt/optimizer.h"
 #include "opt/problem.h"
+#include "opt/throw_search.h"
 #include "opt/windows.h"
 #include "core/error.h"
 #include "scene/scene.h"
+#include "sim/make_system.h"
 #include "toy_system.h"
 
 namespace kf {
@@ -120,17 +122,46 @@ TEST(Strategy, GradientGrowthComparesFramesOfTheForceGradient) {
   EXPECT_NEAR(gradient_growth(problem, z, 27), largest / ref, 1e-12 * largest / ref);
 }
 
-TEST(Strategy, InitialVelocitiesStartFromARigidThrow) {
+TEST(Strategy, InitialVelocitiesStartFromASearchedRigidThrowThenALattice) {
   const Scene scene = strategy_scene(kCloth, R"({"kind": "initial_velocity", "alpha": 0.5})", R"({"max_evaluations": 90})");
   const StagePlan plan = plan_stages(scene);
   EXPECT_TRUE(plan.scaled_first_step);
+  EXPECT_EQ(plan.throw_search, automatic_throw_count(scene.cloth->nx * scene.cloth->ny, scene.time.steps()));
   const auto& stages = plan.stages;
-  ASSERT_EQ(stages.size(), 2u);
+  ASSERT_EQ(stages.size(), 3u);
   ASSERT_TRUE(stages[0].controls);
   EXPECT_EQ(stages[0].controls->kind, ControlKind::kInitialRigidVelocity);
   EXPECT_EQ(stages[0].controls->alpha, 0.5);
-  EXPECT_EQ(stages[0].max_evaluations + stages[1].max_evaluations, 90);
-  EXPECT_FALSE(stages[1].controls);
+  ASSERT_TRUE(stages[1].controls);
+  EXPECT_EQ(stages[1].controls->kind, ControlKind::kInitialLatticeVelocity);
+  EXPECT_EQ(stages[0].max_evaluations + stages[1].max_evaluations + stages[2].max_evaluations, 90);
+  EXPECT_FALSE(stages[2].controls);
+  const Scene no_search =
+      strategy_scene(kCloth, R"({"kind": "initial_velocity"})", R"({"max_evaluations": 90, "throw_search": 0})");
+  EXPECT_EQ(plan_stages(no_search).throw_search, 0);
+}
+
+TEST(Strategy, AutomaticThrowSearchScalesWithTheSimulationsCost) {
+  EXPECT_EQ(automatic_throw_count(144, 45), 512);       // a 12 x 12 towel over 1.5 s: the cap
+  EXPECT_EQ(automatic_throw_count(2500, 56), 32);       // a 50 x 50 sheet: the floor
+  EXPECT_EQ(automatic_throw_count(400, 40), 250);       // 4e6 particle-steps
+}
+
+// The search returns the best throw it simulated: no throw it tried, re-simulated, does better, and the
+// scene's own throw (zero controls) is among them.
+TEST(ThrowSearch, StartsFromTheBestThrowItSimulated) {
+  const Scene scene = strategy_scene(kCloth, R"({"kind": "initial_rigid_velocity"})", R"({"max_evaluations": 10})");
+  auto sys = make_system(scene);
+  Problem problem(scene, scene.time, *sys);
+  const ThrowSearch found = search_throws(problem, 16);
+  EXPECT_EQ(found.simulated, 16);
+  EXPECT_LE(found.phi, found.start_phi);
+  EXPECT_DOUBLE_EQ(problem.evaluate(found.z, nullptr), found.phi);
+  EXPECT_DOUBLE_EQ(problem.evaluate(VecX::Zero(6), nullptr), found.start_phi);
+  EXPECT_GT(found.speed, 0);
+  EXPECT_GT(found.spin, 0);
+  // The same throws on every run.
+  EXPECT_EQ(search_throws(problem, 16).z, found.z);
 }
 
 TEST(Strategy, SingleFlocksAndSchedulesRunAsWritten) {

@@ -137,7 +137,7 @@ const BadScene kBadScenes[] = {
     {"ObjectivesNotAList", "optimize", flock_with("{}", R"(, "objectives": {"type": "shape"})"),
      "s.json: /objectives: expected an array of at least 0 objects, got object {\"type\":\"shape\"}"},
     {"UnknownControlKind", "optimize", flock_with("{}", R"(, "controls": {"kind": "magic"})"),
-     "s.json: /controls/kind: expected one of \"per_step\", \"per_frame\", \"initial_velocity\", \"initial_rigid_velocity\", got \"magic\""},
+     "s.json: /controls/kind: expected one of \"per_step\", \"per_frame\", \"initial_velocity\", \"initial_rigid_velocity\", \"initial_lattice_velocity\", got \"magic\""},
     {"NegativeControlWeight", "optimize", flock_with("{}", R"(, "controls": {"alpha": -1})"),
      "s.json: /controls/alpha: expected a number in [0, 1e+06], got -1"},
     {"RenderWidthZero", "simulate", flock_with("{}", R"(, "render": {"width": 0})"),

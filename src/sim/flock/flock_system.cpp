@@ -26,7 +26,7 @@ FlockSystem::FlockSystem(const FlockSpec& spec, double h, int steps, unsigned se
   adjoint_.resize(spec.agents);
   if (neighbor_forces_.any()) {
     NeighborLists spawn;
-    grid_.search(spawn_positions(spec_, seed_), neighbor_forces_.radius(), spawn);
+    grid_.search_owned(spawn_positions(spec_, seed_), neighbor_forces_.radius(), spawn);
     spawn_entries_ = spawn.entries();
   }
 }
@@ -59,11 +59,14 @@ void FlockSystem::search(FlockRecord& r, const VecX& x, const VecX& v, bool with
     std::fill(r.b.begin(), r.b.end(), 1.0);
     return;
   }
-  grid_.search(x, neighbor_forces_.radius(), r.lists);
+  grid_.search_owned(x, neighbor_forces_.radius(), r.lists);
   most_entries_ = std::max(most_entries_, r.lists.entries());
   if (with_centering) {
     pack_motion(x, v, motion_);
-    parallel_agents(p, [&](int i) { neighbor_forces_.centering(motion_.data(), r.lists.neighbors(i), i, r.offset[i], r.b[i]); });
+    compute_forward_pairs(r);
+    parallel_agents(p, [&](int i) {
+      neighbor_forces_.gather_force(r.lists, pair_index_, forward_pairs_.data(), i, r.offset[i], r.b[i]);
+    });
   }
 }
 

@@ -22,8 +22,9 @@
 
 namespace kf {
 
-// What a flock step found at its state: neighbour lists and centering quantities (offset m_i - x_i in the
-// ground plane, m, and b_i; p each).
+// What a flock step found at its state: neighbour lists, each pair once under its owner
+// (NeighborGrid::search_owned), and centering quantities (offset m_i - x_i in the ground plane, m, and b_i;
+// p each).
 struct FlockRecord final : StepRecord {
   NeighborLists lists;
   std::vector<Planar> offset;

@@ -117,13 +117,12 @@ struct TransposedSum {
   }
 };
 
-// Agent i's pair terms in its list order: those of pairs an earlier agent owns (mirrored), then its own.
+// Agent i's pair terms in the order of its whole list: those of pairs earlier agents own (mirrored), then
+// its own (slots owned.start(i)...).
 template <class Sum, class Pair>
-void gather_pairs(const NeighborLists& l, const PairIndex& index, const Pair* pairs, int i, Sum& sum) {
-  const int begin = l.start(i), owned = index.first_owned(i), end = l.start(i + 1);
-  for (int e = begin; e < owned; ++e) sum.add_mirrored(pairs[index.mirror(e)]);
-  const Pair* own = pairs + index.owned_slot(i);
-  for (int k = 0; k < end - owned; ++k) sum.add(own[k]);
+void gather_pairs(const NeighborLists& owned, const PairIndex& index, const Pair* pairs, int i, Sum& sum) {
+  for (int k : index.mirrored(i)) sum.add_mirrored(pairs[k]);
+  for (int k = owned.start(i), end = owned.start(i + 1); k < end; ++k) sum.add(pairs[k]);
 }
 
 }  // namespace
@@ -146,24 +145,6 @@ Planar NeighborForces::force(const AgentMotion* a, std::span<const int> nbrs, in
   return finish_force(sum.s, offset_i, b_i);
 }
 
-void NeighborForces::centering(const AgentMotion* a, std::span<const int> nbrs, int i, Planar& offset_i,
-                               double& b_i) const {
-  const AgentMotion ai = a[i];
-  double cx = 0, cz = 0, b = 1.0;
-  for (int j : nbrs) {
-    const double dx = ai.x - a[j].x, dz = ai.z - a[j].z;
-    const double r2 = dx * dx + dz * dz;
-    if (r2 < rc2_) {
-      const double w = smooth_kernel_inv(r2, inv_rc2_).w;
-      cx -= w * dx;
-      cz -= w * dz;
-      b += w;
-    }
-  }
-  offset_i = {cx / b, cz / b};
-  b_i = b;
-}
-
 void NeighborForces::transpose_apply(const AgentAdjoint* a, std::span<const int> nbrs, int j, Planar& kt,
                                      Planar& dt) const {
   TransposedSum sum;
@@ -173,8 +154,7 @@ void NeighborForces::transpose_apply(const AgentAdjoint* a, std::span<const int>
 
 void NeighborForces::forward_pairs(const AgentMotion* a, const NeighborLists& l, const PairIndex& index, int i,
                                    PairForward* pairs) const {
-  PairForward* out = pairs + index.owned_slot(i);
-  for (int e = index.first_owned(i), end = l.start(i + 1); e < end; ++e) *out++ = forward_pair(a[i], a[l.entry(e)]);
+  for (int k = l.start(i), end = l.start(i + 1); k < end; ++k) pairs[k] = forward_pair(a[i], a[l.entry(k)]);
 }
 
 Planar NeighborForces::gather_force(const NeighborLists& l, const PairIndex& index, const PairForward* pairs, int i,
@@ -186,9 +166,7 @@ Planar NeighborForces::gather_force(const NeighborLists& l, const PairIndex& ind
 
 void NeighborForces::transposed_pairs(const AgentAdjoint* a, const NeighborLists& l, const PairIndex& index, int j,
                                       PairTransposed* pairs) const {
-  PairTransposed* out = pairs + index.owned_slot(j);
-  for (int e = index.first_owned(j), end = l.start(j + 1); e < end; ++e)
-    *out++ = transposed_pair(a[j], a[l.entry(e)]);
+  for (int k = l.start(j), end = l.start(j + 1); k < end; ++k) pairs[k] = transposed_pair(a[j], a[l.entry(k)]);
 }
 
 void NeighborForces::gather_transposed(const NeighborLists& l, const PairIndex& index, const PairTransposed* pairs,

@@ -69,15 +69,12 @@ class NeighborForces {
   // a: all agents; nbrs: neighbours of i. Returns the force on i (N) and writes offset_i (m) and b_i.
   Planar force(const AgentMotion* a, std::span<const int> nbrs, int i, Planar& offset_i, double& b_i) const;
 
-  // Only offset_i and b_i (for a transposed pass at a state whose forward pass was not recorded).
-  void centering(const AgentMotion* a, std::span<const int> nbrs, int i, Planar& offset_i, double& b_i) const;
-
   // a: all agents (y, offsets and c/b filled). Returns (K^T y)_j in kt and (D^T y)_j in dt.
   void transpose_apply(const AgentAdjoint* a, std::span<const int> nbrs, int j, Planar& kt, Planar& dt) const;
 
-  // The same with each pair once. First, for every agent i (in any order, in parallel): the terms of the
-  // pairs it owns into pairs[index.owned_slot(i)...]. Then, for every agent, the gather: equal to force()
-  // (respectively transpose_apply()) over its whole list.
+  // The same with each pair once, over lists of owned pairs (NeighborGrid::search_owned). First, for every
+  // agent i (in any order, in parallel): the terms of the pairs it owns into pairs[lists.start(i)...]. Then,
+  // for every agent, the gather: equal to force() (respectively transpose_apply()) over its whole list.
   void forward_pairs(const AgentMotion* a, const NeighborLists& lists, const PairIndex& index, int i,
                      PairForward* pairs) const;
   Planar gather_force(const NeighborLists& lists, const PairIndex& index, const PairForward* pairs, int i,

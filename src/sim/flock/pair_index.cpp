@@ -1,27 +1,21 @@
 #include "sim/flock/pair_index.h"
 
-#include "core/check.h"
+#include <algorithm>
 
 namespace kf {
 
-void PairIndex::build(const NeighborLists& lists) {
-  const int p = lists.agents();
-  first_owned_.resize(p);
-  owned_slot_.resize(p);
-  cursor_.resize(p);
-  mirror_.resize(lists.entries());
-  for (int i = 0; i < p; ++i) cursor_[i] = lists.start(i);
-  // Visiting owners in the lists' order, agent i's entries of earlier owners have all been matched when
-  // its turn comes (cursor_[i] has passed them), and each of its own pairs (i, j) is the next unmatched
-  // entry of j, since j's list is sorted by the same order.
-  int slot = 0;
-  for (int i : lists.order()) {
-    first_owned_[i] = cursor_[i];
-    owned_slot_[i] = slot;
-    for (int e = cursor_[i], end = lists.start(i + 1); e < end; ++e) mirror_[cursor_[lists.entry(e)]++] = slot++;
-  }
-  pairs_ = slot;
-  CHECK_EQ(2 * std::size_t(pairs_), std::size_t(lists.entries()));  // symmetric lists
+void PairIndex::build(const NeighborLists& owned) {
+  const int p = owned.agents();
+  start_.assign(p + 1, 0);
+  slot_.resize(owned.entries());
+  for (int k = 0; k < owned.entries(); ++k) ++start_[owned.entry(k) + 1];
+  for (int i = 0; i < p; ++i) start_[i + 1] += start_[i];
+  // Owners visited in the lists' order, so each agent's mirrored pairs come out sorted by owner. start_
+  // serves as the cursor and ends shifted by one agent.
+  for (int i : owned.order())
+    for (int k = owned.start(i), end = owned.start(i + 1); k < end; ++k) slot_[start_[owned.entry(k)]++] = k;
+  std::copy_backward(start_.begin(), start_.end() - 1, start_.end());
+  start_[0] = 0;
 }
 
 }  // namespace kf

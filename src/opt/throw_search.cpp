@@ -1,0 +1,78 @@
+#include "opt/throw_search.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace kf {
+
+namespace {
+
+// The k-th element (k >= 1) of the van der Corput sequence in base b: the digits of k mirrored about the point.
+double radical_inverse(int k, int b) {
+  double f = 1, r = 0;
+  for (; k > 0; k /= b) {
+    f /= b;
+    r += f * (k % b);
+  }
+  return r;
+}
+
+}  // namespace
+
+int automatic_throw_count(int particles, int steps) {
+  const double per_throw = std::max(1.0, double(particles) * std::max(1, steps));
+  return int(std::clamp(4e6 / per_throw, 32.0, 512.0));
+}
+
+ThrowSearch search_throws(Problem& problem, int count) {
+  if (problem.controls().kind() != std::string("initial_rigid_velocity"))
+    throw std::logic_error("search_throws: the problem's controls are not a rigid throw");
+  VecX x0, v0;
+  problem.system().initial_state(x0, v0);
+  const int p = problem.system().particles();
+  Vec3 centre = Vec3::Zero(), mean_v = Vec3::Zero();
+  for (int i = 0; i < p; ++i) {
+    centre += x0.segment<3>(3 * i);
+    mean_v += v0.segment<3>(3 * i);
+  }
+  centre /= std::max(1, p);
+  mean_v /= std::max(1, p);
+  double r2 = 0;
+  for (int i = 0; i < p; ++i) r2 += (x0.segment<3>(3 * i) - centre).squaredNorm();
+  const double radius = std::sqrt(r2 / std::max(1, p));
+
+  ThrowSearch s;
+  s.speed = std::max(1.0, 0.5 * mean_v.norm());
+  s.spin = radius > 0 ? s.speed / radius : 0.0;
+  s.z = VecX::Zero(6);
+  s.start_phi = s.phi = problem.evaluate(s.z, nullptr);
+  if (problem.last_diverged()) s.phi = INFINITY;
+  // Four rounds of a quarter of the throws each: the throw's velocity alone (a spinning sheet rarely lands
+  // where a flat one would), then velocity and spin together in boxes half, a quarter and an eighth as wide
+  // around the best so far.
+  constexpr int kPrimes[6] = {2, 3, 5, 7, 11, 13};
+  constexpr int kRounds = 4;
+  VecX z(6);
+  for (int round = 0; round < kRounds; ++round) {
+    const VecX centre_z = s.z;
+    const double shrink = round == 0 ? 1.0 : std::ldexp(1.0, -round);
+    const int n = count / kRounds + (round < count % kRounds);
+    for (int k = 1; k <= n; ++k) {
+      for (int d = 0; d < 6; ++d) {
+        const double half = shrink * (d < 3 ? s.speed : s.spin);
+        z[d] = centre_z[d] + (d < 3 || round > 0 ? (2 * radical_inverse(k, kPrimes[d]) - 1) * half : 0.0);
+      }
+      const double phi = problem.evaluate(z, nullptr);
+      ++s.simulated;
+      if (!problem.last_diverged() && phi < s.phi) {
+        s.phi = phi;
+        s.z = z;
+      }
+    }
+  }
+  return s;
+}
+
+}  // namespace kf

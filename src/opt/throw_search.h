@@ -1,0 +1,29 @@
+#pragma once
+// A global search over rigid throws, before the rigid throw's L-BFGS. A thrown sheet's objective has basins
+// no gradient leaves: a towel that misses its rail lies on the ground under it, as near the target as it
+// gets there, and every small change of the throw leaves it lying there. The search simulates throws spread
+// evenly over a box around the scene's own (a Halton sequence: the same throws on every run), forward only,
+// and the rigid stage starts from the best of them and the scene's throw.
+#include "core/types.h"
+#include "opt/problem.h"
+
+namespace kf {
+
+struct ThrowSearch {
+  VecX z;                  // the best rigid controls (Δv, ω); zero: the scene's throw was best
+  double phi = 0;          // their objective
+  double start_phi = 0;    // the scene's throw's
+  int simulated = 0;       // throws simulated besides the scene's
+  double speed = 0;        // the box's half-width in Δv (m/s)
+  double spin = 0;         // and in ω (rad/s)
+};
+
+// How many throws the automatic search simulates for a sheet of `particles` over `steps` steps: about four
+// million particle-steps, between 32 and 512 throws.
+int automatic_throw_count(int particles, int steps);
+
+// `problem` must have initial_rigid_velocity controls. The box: Δv within ±max(1 m/s, half the scene's mean
+// initial speed) on each axis, ω within ± that over the sheet's RMS radius (rim speeds alike).
+ThrowSearch search_throws(Problem& problem, int count);
+
+}  // namespace kf
