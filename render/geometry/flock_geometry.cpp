@@ -82,11 +82,15 @@ void build_flock(const Scene& scene, const Trajectory& traj, int f, double scale
     const auto& o = scene.objectives[k];
     std::visit(Overloaded{
                    [&](const ShapeKeyframe& shape) {
-                     std::vector<Vec3> pts;
-                     for (const Vec2& q : shape.polygon) pts.push_back(on_ground(q.x(), q.y()));
                      const Vec3 color =
                          int(k) == next_shape ? rs.target_color : mix(rs.target_color, rs.ground_color, 0.6);
-                     add_ribbon(g.marks, pts, true, line, n, color);
+                     auto outline = [&](const std::vector<Vec2>& loop) {
+                       std::vector<Vec3> pts;
+                       for (const Vec2& q : loop) pts.push_back(on_ground(q.x(), q.y()));
+                       add_ribbon(g.marks, pts, true, line, n, color);
+                     };
+                     outline(shape.polygon);
+                     for (const auto& hole : shape.holes) outline(hole);
                    },
                    [&](const CenterOfMassKeyframe& c) { com.emplace_back(o.frame, c.target); },
                    [&](const PositionKeyframe& pk) {
