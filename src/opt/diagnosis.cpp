@@ -272,9 +272,10 @@ std::string likely_cause(const Sensitivity& s, const RunFacts& facts) {
   if (facts.descent.rough())
     return format("cause: where the optimiser stopped the objective is rough or stiff: along its descent direction "
                   "it falls as the gradient predicts only over %.1g of the way the slope points to (a control "
-                  "change of %.2g), so the line search stalls there; e.g. contact switching, or a sheet balanced "
-                  "where a small push tips it; change: friction on a collider that should hold the sheet, finer "
-                  "time steps (time.substeps), or a keyframe reached with less sliding contact",
+                  "change of %.2g), so the line search stalls there: contact switching, a sheet balanced where a "
+                  "small push tips it, or a sheet pressed against a collider its target lies in or behind; change: "
+                  "move a keyframe that lies in or behind a collider, else friction on a collider that should hold "
+                  "the sheet, finer time steps (time.substeps), or a keyframe reached with less sliding contact",
                   facts.descent.linear_fraction, facts.descent.linear_fraction * facts.descent.reach());
   return smooth_cause(s, facts);
 }
