@@ -269,14 +269,19 @@ std::string likely_cause(const Sensitivity& s, const RunFacts& facts) {
     return format("cause: its budget ended it after %.0f evaluations (the objective still fell %.2gx over the "
                   "last tenth of them); change: raise optimizer.max_evaluations",
                   facts.evaluations, 1 / std::max(facts.recent_improvement, 1e-300));
-  if (facts.descent.rough())
-    return format("cause: where the optimiser stopped the objective is rough or stiff: along its descent direction "
-                  "it falls as the gradient predicts only over %.1g of the way the slope points to (a control "
-                  "change of %.2g), so the line search stalls there: contact switching, a sheet balanced where a "
-                  "small push tips it, or a sheet pressed against a collider its target lies in or behind; change: "
-                  "move a keyframe that lies in or behind a collider, else friction on a collider that should hold "
-                  "the sheet, finer time steps (time.substeps), or a keyframe reached with less sliding contact",
-                  facts.descent.linear_fraction, facts.descent.linear_fraction * facts.descent.reach());
+  if (facts.descent.rough()) {
+    const DescentProbe& d = facts.descent;
+    return "cause: where the optimiser stopped the objective is rough or stiff: along its descent direction it " +
+           (d.linear_fraction > 0 ? format("falls as the gradient predicts only over %.1g of the way the slope "
+                                           "points to (a control change of %.2g)",
+                                           d.linear_fraction, d.linear_fraction * d.reach())
+                                  : std::string("does not fall as the gradient predicts even over 1e-06 of the way "
+                                                "the slope points to")) +
+           ", so the line search stalls there: contact switching, a sheet balanced where a small push tips it, or a "
+           "sheet pressed against a collider its target lies in or behind; change: move a keyframe that lies in or "
+           "behind a collider, else friction on a collider that should hold the sheet, finer time steps "
+           "(time.substeps), or a keyframe reached with less sliding contact";
+  }
   return smooth_cause(s, facts);
 }
 

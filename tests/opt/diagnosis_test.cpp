@@ -127,6 +127,9 @@ TEST(Diagnosis, CauseNamesNoiseThenAmplificationThenBudgetThenReach) {
   EXPECT_NE(line.find("the objective is rough or stiff"), std::string::npos) << line;
   EXPECT_NE(line.find("a control change of 2e-10"), std::string::npos) << line;
   EXPECT_EQ(line.find("out of reach"), std::string::npos) << line;
+  f.descent.linear_fraction = 0;  // not even the smallest step
+  line = diagnose(k, s, f).line;
+  EXPECT_NE(line.find("does not fall as the gradient predicts even over 1e-06"), std::string::npos) << line;
   f.descent.linear_fraction = 1e-2;
   EXPECT_NE(diagnose(k, s, f).line.find("out of reach"), std::string::npos);
 }
