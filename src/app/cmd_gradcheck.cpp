@@ -5,6 +5,7 @@
 
 #include "app/commands.h"
 #include "core/error.h"
+#include "opt/controls_file.h"
 #include "opt/gradcheck.h"
 #include "scene/scene.h"
 #include "sim/make_system.h"
@@ -20,6 +21,8 @@ struct GradcheckCommandOptions {
   std::string solver = "direct";
   unsigned seed = 7;
   std::string adjoint;
+  std::string at;  // a run directory whose controls.bin the check is made at
+  int line = 0;    // points of φ along the negative gradient (0: none)
 };
 
 // The scene as the check runs it: shortened, resampled in time, with the requested adjoint and solve.
@@ -38,14 +41,39 @@ Scene gradcheck_scene(const GradcheckCommandOptions& o) {
   return scene;
 }
 
+// φ at z - t g / |g| for t = 1e-8 .. 1e-1 (relative to max(1, |z|∞)), log-spaced: where the first points
+// do not fall as t |g| predicts, the gradient describes φ only at a scale below the smallest step.
+nlohmann::json objective_along_descent(Problem& problem, const VecX& z, int points) {
+  VecX g(problem.size());
+  const double phi0 = problem.evaluate(z, &g);
+  const double gnorm = g.norm(), scale = std::max(1.0, z.lpNorm<Eigen::Infinity>());
+  nlohmann::json line = nlohmann::json::array();
+  if (!(gnorm > 0)) return line;
+  for (int k = 0; k < points; ++k) {
+    const double t = scale * std::pow(10.0, -8.0 + 7.0 * k / std::max(1, points - 1));
+    const double phi = problem.evaluate(z - (t / gnorm) * g, nullptr);
+    line.push_back({{"step", t}, {"phi", phi}, {"predicted", phi0 - t * gnorm}});
+  }
+  return line;
+}
+
 void run_gradcheck(const GradcheckCommandOptions& o) {
   const Scene scene = gradcheck_scene(o);
   auto sys = make_system(scene, scene.time.h());
   Problem problem(scene, scene.time, *sys);
   VecX z = problem.initial_guess();
-  std::mt19937_64 rng(o.seed);
-  std::normal_distribution<double> normal(0.0, o.perturb);
-  for (int i = 0; i < z.size(); ++i) z[i] += normal(rng);
+  if (!o.at.empty()) {
+    int substeps = 0;
+    z = load_controls(std::filesystem::path(o.at) / "controls.bin", &substeps);
+    if (z.size() != problem.size() || substeps != scene.time.substeps)
+      throw InputError(o.at + "/controls.bin: holds " + std::to_string(z.size()) + " controls at " +
+                       std::to_string(substeps) + " substeps; the scene's controls are " +
+                       std::to_string(problem.size()) + " at " + std::to_string(scene.time.substeps));
+  } else {
+    std::mt19937_64 rng(o.seed);
+    std::normal_distribution<double> normal(0.0, o.perturb);
+    for (int i = 0; i < z.size(); ++i) z[i] += normal(rng);
+  }
   const GradcheckResult r = gradcheck(
       problem, z, {.samples = o.samples, .eps = o.eps, .kink_tolerance = o.kink_tolerance, .seed = o.seed});
   nlohmann::json j = r.to_json();
@@ -53,6 +81,7 @@ void run_gradcheck(const GradcheckCommandOptions& o) {
   j["h"] = scene.time.h();
   j["steps"] = scene.time.steps();
   j["control_variables"] = problem.size();
+  if (o.line > 0) j["line"] = objective_along_descent(problem, z, o.line);
   if (scene.cloth) {
     j["adjoint"] = scene.optimizer.adjoint;
     j["solver"] = scene.cloth->solver;
@@ -84,6 +113,10 @@ void add_gradcheck_options(CLI::App* sub, const std::shared_ptr<GradcheckCommand
   sub->add_option("--perturb", o->perturb, "scale of the random controls the check is made at (0: the scene's initial guess)")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
+  sub->add_option("--at", o->at, "check at a run's controls (RUN_DIR/controls.bin) instead of perturbed ones")
+      ->excludes(sub->get_option("--perturb"));
+  sub->add_option("--line", o->line, "also print φ at this many log-spaced steps along the negative gradient")
+      ->check(CLI::Range(0, 1000));
   sub->add_option("--seed", o->seed, "seed for the sample and the controls")->capture_default_str();
   sub->add_option("--adjoint", o->adjoint, "cloth adjoint: exact (the step's own Jacobian) or swap (the paper's "
                                            "integrator swap); default: the scene's optimizer.adjoint")

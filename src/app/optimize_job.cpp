@@ -303,7 +303,7 @@ nlohmann::json report_summary(const Scene& scene, size_t stages, bool resuming, 
 // Whether the keyframes were reached and, if not, why (opt/diagnosis.h), into job.diagnosis and the report.
 void diagnose_run(const Scene& scene, JobResult& job, const EvaluationLog& elog, const UncontrolledRun& before,
                   double final_objective, nlohmann::json& report) {
-  const Problem& problem = *job.problem;
+  Problem& problem = *job.problem;
   double effort_end = 0;
   for (const auto& [name, value] : problem.breakdown())
     if (name == "effort") effort_end = value;
@@ -315,6 +315,12 @@ void diagnose_run(const Scene& scene, JobResult& job, const EvaluationLog& elog,
   facts.keyframe_objective_end = final_keyframes;
   facts.effort_end = effort_end;
   job.diagnosis = diagnose(keyframes, sensitivity, facts);
+  if (job.diagnosis.failed() && !facts.budget && !job.interrupted) {  // why the line search stalled
+    facts.descent = probe_descent(problem, job.z);
+    problem.evaluate(job.z, nullptr);  // the run's own rollout again, for the run statistics read after this
+    job.diagnosis = diagnose(keyframes, sensitivity, facts);
+    report["descent_probe"] = facts.descent.to_json();
+  }
   report["diagnosis"] = job.diagnosis.to_json();
   report["diagnosis"]["keyframe_objective_start"] = before.keyframes;
   report["diagnosis"]["keyframe_objective_end"] = final_keyframes;

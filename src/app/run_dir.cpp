@@ -56,7 +56,7 @@ void prepare_run_dir(const fs::path& dir, const Scene& scene) {
 }
 
 void absolutise_scene_paths(nlohmann::json& j, const fs::path& scene_dir) {
-  // A character's mesh and a cape's start and target runs are named relative to the scene's directory.
+  // A character's mesh, a cape's start and target runs and SVG files are named relative to the scene's directory.
   const fs::path base = fs::absolute(scene_dir.empty() ? fs::path(".") : scene_dir);
   auto absolutise = [&](nlohmann::json& parent, const char* key) {
     if (parent.is_object() && parent.contains(key) && parent[key].is_string())
@@ -68,6 +68,10 @@ void absolutise_scene_paths(nlohmann::json& j, const fs::path& scene_dir) {
     if (c.contains("start")) absolutise(c["start"], "run");
     if (c.contains("end_target")) absolutise(c["end_target"], "run");
   }
+  // And a shape keyframe's SVG file.
+  if (j.contains("objectives") && j["objectives"].is_array())
+    for (auto& o : j["objectives"])
+      if (o.is_object() && o.contains("svg_path")) absolutise(o["svg_path"], "file");
 }
 
 Scene load_run_scene(const fs::path& dir) {

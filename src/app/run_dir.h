@@ -20,8 +20,8 @@ void commit_run_dir(StagedDir& staged, const std::function<void(const std::files
 void naming_run_dir(const StagedDir& staged, const std::function<void()>& step);
 // Creates the directory and stores a copy of the scene file as scene.json (atomically).
 void prepare_run_dir(const std::filesystem::path& dir, const Scene& scene);
-// Names a scene's relative asset paths (a character's mesh, a cape's start and target runs) absolutely from
-// `scene_dir`, so that a copy of the scene JSON reads the same from any directory.
+// Names a scene's relative asset paths (a character's mesh, a cape's start and target runs, a shape's SVG file)
+// absolutely from `scene_dir`, so that a copy of the scene JSON reads the same from any directory.
 void absolutise_scene_paths(nlohmann::json& scene, const std::filesystem::path& scene_dir);
 // Loads the scene copy a run directory holds (named by its scene_name.txt). Throws InputError if it is not a
 // run directory or its scene_name.txt is not a safe name.

@@ -103,17 +103,18 @@ std::vector<Vec2> region_samples(const GroundRegion& region, double spacing) {
   return out;
 }
 
-std::string region_problem(const GroundRegion& region) {
+std::string region_problem(const GroundRegion& region, const std::vector<std::string>& hole_names) {
+  auto name_of = [&](size_t h) { return h < hole_names.size() ? hole_names[h] : "hole " + std::to_string(h); };
   for (size_t h = 0; h < region.holes.size(); ++h) {
     const auto& hole = region.holes[h];
-    const std::string name = "hole " + std::to_string(h);
+    const std::string name = name_of(h);
     for (const Vec2& v : hole)
       if (!loop_contains(region.outer, v)) return name + " has a point outside the outer shape";
     if (loops_meet(hole, region.outer)) return name + " crosses the outer shape's edge";
     for (size_t o = 0; o < h; ++o) {
       const auto& other = region.holes[o];
       if (loops_meet(hole, other) || loop_contains(other, hole.front()) || loop_contains(hole, other.front()))
-        return name + " overlaps hole " + std::to_string(o);
+        return name + " overlaps " + name_of(o);
     }
   }
   return "";

@@ -27,7 +27,8 @@ Vec2 closest_point_in_polygon(const GroundRegion& region, const Vec2& q, bool* i
 std::vector<Vec2> region_samples(const GroundRegion& region, double spacing);
 
 // Why the loops are not an outer polygon with holes, as "hole K ..." (a vertex outside the outer loop or
-// inside another hole, edges of two loops crossing); empty when they are.
-std::string region_problem(const GroundRegion& region);
+// inside another hole, edges of two loops crossing); empty when they are. `hole_names` (optional) replaces
+// "hole K" in the message.
+std::string region_problem(const GroundRegion& region, const std::vector<std::string>& hole_names = {});
 
 }  // namespace kf

@@ -167,6 +167,32 @@ Sensitivity measure_sensitivity(const Scene& scene, const TimeSpec& time) {
   return s;
 }
 
+DescentProbe probe_descent(Problem& problem, const VecX& z) {
+  DescentProbe p;
+  VecX g(problem.size());
+  p.phi = problem.evaluate(z, &g);
+  p.grad_norm = g.norm();
+  if (problem.last_diverged() || !(p.grad_norm > 0) || !(p.phi > 0)) return p;
+  const double reach = p.phi / p.grad_norm;
+  const VecX dir = g / p.grad_norm;
+  p.linear_fraction = 0;
+  bool linear = true;
+  for (int k = 0; k <= 12; ++k) {
+    const double fraction = std::pow(10.0, -6.0 + 0.5 * k), t = fraction * reach;
+    const double phi = problem.evaluate(z - t * dir, nullptr);
+    p.steps.push_back(t);
+    p.phis.push_back(phi);
+    linear = linear && !problem.last_diverged() && phi <= p.phi - 0.5 * t * p.grad_norm;
+    if (linear) p.linear_fraction = fraction;
+  }
+  return p;
+}
+
+nlohmann::json DescentProbe::to_json() const {
+  return {{"phi", phi}, {"grad_norm", grad_norm}, {"linear_fraction", linear_fraction}, {"steps", steps},
+          {"phi_along_descent", phis}};
+}
+
 nlohmann::json Diagnosis::to_json() const {
   return {{"outcome", outcome}, {"reached", reached}, {"progress", progress}, {"far", far}, {"failed", failed()},
           {"diagnosis", line}};
@@ -243,6 +269,19 @@ std::string likely_cause(const Sensitivity& s, const RunFacts& facts) {
     return format("cause: its budget ended it after %.0f evaluations (the objective still fell %.2gx over the "
                   "last tenth of them); change: raise optimizer.max_evaluations",
                   facts.evaluations, 1 / std::max(facts.recent_improvement, 1e-300));
+  if (facts.descent.rough()) {
+    const DescentProbe& d = facts.descent;
+    return "cause: where the optimiser stopped the objective is rough or stiff: along its descent direction it " +
+           (d.linear_fraction > 0 ? format("falls as the gradient predicts only over %.1g of the way the slope "
+                                           "points to (a control change of %.2g)",
+                                           d.linear_fraction, d.linear_fraction * d.reach())
+                                  : std::string("does not fall as the gradient predicts even over 1e-06 of the way "
+                                                "the slope points to")) +
+           ", so the line search stalls there: contact switching, a sheet balanced where a small push tips it, or a "
+           "sheet pressed against a collider its target lies in or behind; change: move a keyframe that lies in or "
+           "behind a collider, else friction on a collider that should hold the sheet, finer time steps "
+           "(time.substeps), or a keyframe reached with less sliding contact";
+  }
   return smooth_cause(s, facts);
 }
 

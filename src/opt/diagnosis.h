@@ -63,6 +63,23 @@ struct Sensitivity {
 // gradient and six more evaluations of φ. Keyframes at frame 0 only: an empty gradient_by_frame.
 Sensitivity measure_sensitivity(const Scene& scene, const TimeSpec& time);
 
+// φ along the negative gradient at the point an optimisation stopped: at distances t = 1e-6 .. 1 times
+// φ / |g| (where the linear prediction φ - t |g| reaches 0), log-spaced. On smooth ground φ falls as its
+// gradient predicts over a fair part of that distance; where contact switches or a held split pattern has
+// gone stale, it does so only over a sliver, and a line search there stalls however good the gradient.
+struct DescentProbe {
+  double phi = 0, grad_norm = 0;
+  std::vector<double> steps, phis;  // t (control units) and φ there
+  // The largest t / (φ / |g|) up to which every point fell at least half as much as predicted
+  // (0: not even the first; 1: not measured or smooth throughout).
+  double linear_fraction = 1;
+  bool rough() const { return linear_fraction < 1e-3; }
+  double reach() const { return grad_norm > 0 ? phi / grad_norm : 0.0; }  // φ / |g|, control units
+  nlohmann::json to_json() const;
+};
+class Problem;
+DescentProbe probe_descent(Problem& problem, const VecX& z);
+
 // What the optimiser's run shows besides its keyframes.
 struct RunFacts {
   std::string status;                // why the last stage stopped
@@ -74,6 +91,7 @@ struct RunFacts {
   double objective_start = 0;        // φ at the first evaluation
   double recent_improvement = 1;     // best φ at the end over the best φ 10 % of the evaluations earlier
   int evaluations = 0;
+  DescentProbe descent;              // at the best point, when the keyframes were not reached
 };
 
 struct Diagnosis {

@@ -9,6 +9,7 @@
 #include "core/ground_region.h"
 #include "core/json_depth.h"
 #include "scene/params.h"
+#include "scene/svg_shape_spec.h"
 
 namespace kf {
 
@@ -86,26 +87,32 @@ std::pair<std::vector<Vec2>, std::vector<Vec2>> parse_ring(Block c) {
   return {circle_loop(center, outer, n), circle_loop(center, inner, n)};
 }
 
-// A loop given as "polygon" [[x, z], ...] or "circle" {...}: a shape's outline or one of its holes.
-std::vector<Vec2> parse_loop(Block& b, const std::string& also) {
-  if (b.has("polygon") + b.has("circle") + (also.empty() ? 0 : b.has(also)) != 1)
-    b.fail_here("expected one of \"polygon\" [[x, z], ...] or \"circle\" {\"center\": [x, z], \"radius\"}" +
-                (also.empty() ? std::string() : " or \"ring\" {\"center\", \"inner_radius\", \"outer_radius\"}"));
+// A loop given as "polygon" [[x, z], ...] or "circle" {...}: one of a shape's holes, or its outline.
+std::vector<Vec2> parse_loop(Block& b) {
+  if (b.has("polygon") + b.has("circle") != 1)
+    b.fail_here("expected one of \"polygon\" [[x, z], ...] or \"circle\" {\"center\": [x, z], \"radius\"}");
   return b.has("circle") ? parse_circle(b.child("circle")) : b.points2("polygon", 3);
 }
 
 ObjectiveKind parse_shape(Block& b, const ObjectiveSpec&, const Scene& s) {
   if (!s.flock) b.fail("type", "\"shape\" keyframes are for flocks; use \"position\" or \"arch\" for cloth");
   ShapeKeyframe k;
-  if (b.has("ring") && !b.has("polygon") && !b.has("circle")) {
+  if (b.has("polygon") + b.has("circle") + b.has("ring") + b.has("svg_path") != 1)
+    b.fail_here("expected one of \"polygon\" [[x, z], ...], \"circle\" {\"center\": [x, z], \"radius\"}, "
+                "\"ring\" {\"center\", \"inner_radius\", \"outer_radius\"} or \"svg_path\" {\"d\" or \"file\"}");
+  if (b.has("ring")) {
     auto [outer, inner] = parse_ring(b.child("ring"));
     k.polygon = std::move(outer);
     k.holes.push_back(std::move(inner));
+  } else if (b.has("svg_path")) {
+    ShapeLoops loops = parse_svg_shape(b.child("svg_path"), s.directory);
+    k.polygon = std::move(loops.outer);
+    k.holes = std::move(loops.holes);
   } else {
-    k.polygon = parse_loop(b, "ring");
+    k.polygon = parse_loop(b);
   }
   for (Block& hole : b.array("holes")) {
-    k.holes.push_back(parse_loop(hole, ""));
+    k.holes.push_back(parse_loop(hole));
     hole.finish();
   }
   if (const std::string problem = region_problem(GroundRegion(k.polygon, k.holes)); !problem.empty())

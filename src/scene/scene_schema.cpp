@@ -17,7 +17,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A flock with every flock objective type and shape kind, a schedule, a first step and a camera.
+// A flock with every flock objective type and shape kind (an SVG path inline and from a file), a schedule,
+// a first step and a camera.
 std::string flock_scene(int frames, int agents) {
   return R"({
   "$schema": "scene.schema.json",
@@ -33,7 +34,10 @@ std::string flock_scene(int frames, int agents) {
     {"type": "shape", "frame": 10, "polygon": [[0, 0], [1, 0], [0, 1]], "coverage": {"weight": 1}},
     {"type": "shape", "frame": 10, "circle": {"center": [0, 0], "radius": 2, "segments": 16}},
     {"type": "shape", "frame": 10, "ring": {"center": [0, 0], "inner_radius": 1, "outer_radius": 4, "segments": 16},
-     "holes": [{"polygon": [[2, -0.2], [2.5, -0.2], [2.5, 0.2]]}, {"circle": {"center": [-2.5, 0], "radius": 0.3}}]}
+     "holes": [{"polygon": [[2, -0.2], [2.5, -0.2], [2.5, 0.2]]}, {"circle": {"center": [-2.5, 0], "radius": 0.3}}]},
+    {"type": "shape", "frame": 10, "svg_path": {"d": "M 0 0 H 8 V 8 H 0 Z M 2 2 h 2 v 2 h -2 z", "scale": 0.5,
+                                                 "offset": [-2, -2], "tolerance": 0.02}},
+    {"type": "shape", "frame": 10, "svg_path": {"file": "shape.svg"}}
   ],
   "controls": {"kind": "per_frame"},
   "optimizer": {"schedule": [{"substeps": 1}], "first_step": 0.5},
@@ -66,6 +70,7 @@ std::vector<ParamLog> every_branch_logs(const fs::path& scratch) {
   fs::create_directories(scratch);
   // Parsing only checks that the character's file exists; its meshes and nodes are read when simulating.
   std::ofstream(scratch / "character.x") << "xof 0303txt 0032\n";
+  std::ofstream(scratch / "shape.svg") << "<svg><path d=\"M 0 0 A 1 1 0 0 1 2 0 Z\"/></svg>\n";
   struct Size {
     int frames, agents, cloth_n;
   };

@@ -61,6 +61,31 @@ TEST_F(GradcheckBenchCli, GradcheckPrintsOneJsonObjectWithTheChecksNumbers) {
   EXPECT_NE(bad.output.find("--dt"), std::string::npos) << bad.output;
 }
 
+// Where an optimisation stopped: the check at a run's own controls, and φ along the negative gradient there,
+// which at the smallest step falls as the gradient predicts (the probe that tells a kink from a bad gradient).
+TEST_F(GradcheckBenchCli, GradcheckAtARunsControlsProbesTheDescentLine) {
+  const std::string scene = KEYFRAME_SOURCE_DIR "/scenes/square.json";
+  ASSERT_EQ(run_keyframe("optimize " + scene + " --max-evaluations 3 --quiet --out run", dir_).code, 7);  // not reached in 3
+  const auto at = stdout_json("gradcheck " + scene + " --at run --samples 4 --line 8", dir_);
+  SCOPED_TRACE(at.dump());
+  EXPECT_LE(at["max_rel_error"].get<double>(), 1e-5);
+  ASSERT_EQ(at["line"].size(), 8u);
+  const double phi = at["phi"].get<double>(), g = at["grad_norm"].get<double>();
+  const auto& first = at["line"][0];
+  EXPECT_LT(first["phi"].get<double>(), phi);
+  EXPECT_NEAR(first["phi"].get<double>(), first["predicted"].get<double>(), 1e-3 * first["step"].get<double>() * g);
+  double previous = 0;
+  for (const auto& p : at["line"]) {  // steps grow
+    EXPECT_GT(p["step"].get<double>(), previous);
+    previous = p["step"].get<double>();
+  }
+
+  // Controls of another length (the scene shortened) are refused with what was found and expected.
+  const auto bad = run_keyframe("gradcheck " + scene + " --at run --frames 4", dir_);
+  EXPECT_EQ(bad.code, kExitInput) << bad.output;
+  EXPECT_NE(bad.output.find("run/controls.bin: holds"), std::string::npos) << bad.output;
+}
+
 TEST_F(GradcheckBenchCli, TinyFlockBenchWritesItsCsvPlotAndSummary) {
   const std::string crowd = " --crowd-scene " KEYFRAME_SOURCE_DIR "/scenes/square.json --crowd-agents 40 "
                             "--crowd-evaluations 2 --crowd-budget-agents 40 --crowd-budget 0.0001";

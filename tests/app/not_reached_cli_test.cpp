@@ -75,6 +75,20 @@ TEST_F(NotReached, SheetOnASphereAmplifiesPerturbations) {
   EXPECT_EQ(s.at("gradient_by_frame").size(), 24u);
 }
 
+// A towel dropped off-centre onto a thin rail, asked to hang centred on it: the optimiser balances it where a
+// push of a few micronewtons tips it, the line search stalls, and the cause is the ground, not the target.
+TEST_F(NotReached, TowelBalancedOnAThinRailStallsOnRoughGround) {
+  const CliResult r = optimise(read_text(KEYFRAME_SOURCE_DIR "/scenes/robustness/towel-rail-offcentre.json"));
+  EXPECT_EQ(r.code, kExitNotReached) << r.output;
+  EXPECT_NE(r.output.find("rough or stiff"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("out of reach"), std::string::npos) << r.output;
+  const auto& probe = report_.at("descent_probe");
+  EXPECT_EQ(probe.at("phi_along_descent").size(), 13u);
+  EXPECT_LT(probe.at("linear_fraction").get<double>(), 1e-3) << probe.dump();
+  // It is rough, not wrong: the smallest step still falls as the gradient predicts.
+  EXPECT_LT(probe.at("phi_along_descent")[0].get<double>(), probe.at("phi").get<double>()) << probe.dump();
+}
+
 TEST_F(NotReached, TargetOutOfReachOfAHangingSheet) {
   // Pinned along its top edge 1 m up, a 1 m sheet cannot put its centre of mass 3 m below the pins.
   const CliResult r = optimise(R"({"time": {"fps": 30, "frames": 10},

@@ -119,6 +119,19 @@ TEST(Diagnosis, CauseNamesNoiseThenAmplificationThenBudgetThenReach) {
   line = diagnose(k, s, f).line;
   EXPECT_NE(line.find("lower controls.alpha"), std::string::npos) << line;
   EXPECT_NE(line.find("effort is 69 %"), std::string::npos) << line;
+  f = facts(10, 9);
+  f.descent.linear_fraction = 1e-5;  // the slope holds over a sliver of the way: rough, not out of reach
+  f.descent.phi = 2e-3;
+  f.descent.grad_norm = 100;
+  line = diagnose(k, s, f).line;
+  EXPECT_NE(line.find("the objective is rough or stiff"), std::string::npos) << line;
+  EXPECT_NE(line.find("a control change of 2e-10"), std::string::npos) << line;
+  EXPECT_EQ(line.find("out of reach"), std::string::npos) << line;
+  f.descent.linear_fraction = 0;  // not even the smallest step
+  line = diagnose(k, s, f).line;
+  EXPECT_NE(line.find("does not fall as the gradient predicts even over 1e-06"), std::string::npos) << line;
+  f.descent.linear_fraction = 1e-2;
+  EXPECT_NE(diagnose(k, s, f).line.find("out of reach"), std::string::npos);
 }
 
 }  // namespace
