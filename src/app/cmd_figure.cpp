@@ -41,7 +41,7 @@ void add_figure_command(CLI::App& app) {
   auto frames = std::make_shared<std::string>();
   auto size = std::make_shared<std::string>();
   auto camera = std::make_shared<CameraWords>();
-  sub->add_option("RUN_DIR", req->run_dirs, "run directories, one row each")->required();
+  sub->add_option("RUN_DIR", req->run_dirs, "run directories, one row each (at least one)");
   sub->add_option("--frames", *frames,
                   "comma-separated frames, e.g. 0,30,60; 'key' = each run's last keyframe, 'last' = its last "
                   "frame (default: 0, keyframes, last)");
@@ -68,6 +68,8 @@ void add_figure_command(CLI::App& app) {
               "  fig. 6  keyframe figure out/cape-a out/cape-blend out/cape-b --columns --frames 0,15,last");
   sub->callback([=] {
     render::FigureRequest r = *req;
+    for (const std::string& dir : positionals_after_camera(*camera)) r.run_dirs.push_back(dir);
+    if (r.run_dirs.empty()) throw CLI::RequiredError("RUN_DIR");
     r.camera = camera_choice(*camera);
     if (!frames->empty()) r.frames = parse_figure_frames(*frames);
     if (!size->empty()) {

@@ -19,7 +19,8 @@ void add_render_command(CLI::App& app) {
   auto camera = std::make_shared<CameraWords>();
   std::string names;
   for (const auto& n : render::backend_names()) names += (names.empty() ? "" : "|") + n;
-  sub->add_option("RUN_DIR", req->run_dir, "run directory holding scene.json and trajectory.bin")->required();
+  auto run_dir = std::make_shared<std::string>();
+  sub->add_option("RUN_DIR", *run_dir, "run directory holding scene.json and trajectory.bin (required)");
   sub->add_option("--backend", req->backend,
                   "renderer: osmesa = fast raster preview, embree = ray traced with soft shadows (" + names + ")")
       ->capture_default_str();
@@ -36,6 +37,7 @@ void add_render_command(CLI::App& app) {
               "         keyframe render out/cape-a --camera \"eye=0,1.6,4 target=0,1,0 fov=35\"");
   sub->callback([=] {
     render::RenderRequest r = *req;
+    r.run_dir = one_positional(*camera, *run_dir, "RUN_DIR");
     if (!size->empty()) parse_size(*size, r.width, r.height);
     if (!frames->empty()) parse_frames(*frames, r.frame_begin, r.frame_end);
     if (!views->empty()) parse_frames(*views, r.view_begin, r.view_end, "--views");

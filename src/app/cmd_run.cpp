@@ -17,7 +17,7 @@ void add_run_command(CLI::App& app) {
   auto req = std::make_shared<render::RenderRequest>();
   auto size = std::make_shared<std::string>();
   auto camera = std::make_shared<CameraWords>();
-  sub->add_option("SCENE", *scene, "scene file (JSON)")->required();
+  sub->add_option("SCENE", *scene, "scene file (JSON) (required)");
   add_optimize_options(sub, *opts);
   sub->add_option("--backend", req->backend, "renderer: osmesa (fast preview) or embree (ray traced)")
       ->check(CLI::IsMember(render::backend_names()))
@@ -28,9 +28,10 @@ void add_run_command(CLI::App& app) {
   sub->footer("Example: keyframe run scenes/square.json --backend embree --size 1280x720 --spp 16");
   sub->callback([=] {
     render::RenderRequest r = *req;
+    const std::string scene_file = one_positional(*camera, *scene, "SCENE");
     if (!size->empty()) parse_size(*size, r.width, r.height);  // a bad size or camera fails before the optimisation
     r.camera = camera_choice(*camera);
-    const auto outcome = optimize_job(*scene, *opts);
+    const auto outcome = optimize_job(scene_file, *opts);
     exit_if_interrupted(outcome);
     const auto& dir = outcome.dir;
     r.run_dir = dir;
