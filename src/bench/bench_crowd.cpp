@@ -43,6 +43,7 @@ nlohmann::json scaled_scene(const nlohmann::json& base, int agents) {
 
 struct ChildRun {
   double wall_s = 0;
+  double cpu_s = 0;  // user + system, all threads: what a loaded machine's wall time does not show
   long peak_kb = 0;
   int status = 0;
 };
@@ -65,6 +66,7 @@ ChildRun run_child(const std::vector<std::string>& args) {
   ChildRun r;
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.peak_kb = ru.ru_maxrss;
+  r.cpu_s = double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
   r.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   return r;
 }
@@ -101,7 +103,7 @@ CrowdPoint run_crowd_point(const nlohmann::json& base, int agents, double max_gb
 CsvTable crowd_table() {
   return CsvTable({"agents", "control_variables", "steps", "max_memory_gb", "checkpoint_every", "evaluations",
                    "optimize_s", "s_per_evaluation", "peak_mb", "bytes_per_agent_step", "inside_first",
-                   "inside_second", "status"});
+                   "inside_second", "status", "cpu_s"});
 }
 
 void add_crowd_row(const CrowdPoint& p, CsvTable& t) {
@@ -114,7 +116,7 @@ void add_crowd_row(const CrowdPoint& p, CsvTable& t) {
   t.add({std::to_string(p.agents), std::to_string(rep["control_variables"].get<long>()), std::to_string(steps),
          fmt(rep["memory_budget_gb"]), std::to_string(rep["checkpoint_every_for_budget"].get<int>()),
          std::to_string(evals), fmt(secs), fmt(secs / std::max(evals, 1)), fmt(p.child.peak_kb / 1024.0),
-         fmt(per_agent_step), inside(0), inside(1), std::to_string(p.child.status)});
+         fmt(per_agent_step), inside(0), inside(1), std::to_string(p.child.status), fmt(p.child.cpu_s)});
 }
 
 // Agents, seconds per evaluation and peak MB of the runs without a memory budget, for the fitted exponents.

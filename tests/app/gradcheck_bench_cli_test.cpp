@@ -144,6 +144,8 @@ TEST_F(GradcheckBenchCli, TinyFlockBenchWritesItsCsvPlotAndSummary) {
     EXPECT_EQ(row[0], "40");
     EXPECT_EQ(row[5], "2");           // evaluations
     EXPECT_GT(std::stod(row[8]), 1);  // peak MB of the child process
+    ASSERT_EQ(row.size(), 14u);
+    EXPECT_GT(std::stod(row[13]), 0);  // CPU seconds of the child process
   }
   EXPECT_EQ(crowd_rows[0][4], "0");
   EXPECT_GT(std::stoi(crowd_rows[1][4]), 1) << "the budget must switch checkpointing on";

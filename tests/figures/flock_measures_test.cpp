@@ -1,0 +1,75 @@
+// The flock's figure measures that compare agents with each other or with sample points (nearest spacing,
+// coverage) use a neighbour grid; they must give exactly what comparing every pair gives.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "report/figure_measures.h"
+
+namespace kf {
+namespace {
+
+VecX scattered(int p, double box, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-box, box);
+  VecX x = VecX::Zero(3 * p);
+  for (int i = 0; i < p; ++i) x[3 * i] = u(rng), x[3 * i + 2] = u(rng);
+  return x;
+}
+
+TEST(FlockMeasures, NearestSpacingEqualsAllPairs) {
+  std::mt19937_64 rng(3);
+  int far_checked = 0;
+  for (int p : {1, 2, 3, 50, 1500})
+    for (double box : {0.2, 10.0, 300.0}) {
+      VecX x = scattered(p, box, rng);
+      if (p > 10) {
+        seg(x, 1) = seg(x, 0);                        // coincident: spacing 0
+        seg(x, 2) = Vec3(50 * box, 0, -40 * box);     // a stray far beyond every other agent
+        seg(x, 3) = Vec3(-3 * box, 0, 2 * box);       // and one outside the cluster
+        for (int i = 4; i < p / 2; ++i) x[3 * i] *= 0.01;  // half of them bunched in a strip
+      }
+      const std::vector<double> got = nearest_neighbour_spacing(x);
+      ASSERT_EQ(int(got.size()), p);
+      for (int i = 0; i < p; ++i) {
+        double want = std::numeric_limits<double>::infinity();
+        for (int j = 0; j < p; ++j)
+          if (j != i) want = std::min(want, std::hypot(x[3 * i] - x[3 * j], x[3 * i + 2] - x[3 * j + 2]));
+        ASSERT_EQ(got[i], want) << "p " << p << " box " << box << " agent " << i;
+      }
+      if (p > 10) {
+        EXPECT_EQ(got[0], 0.0);
+        far_checked += got[2] > 10 * box;
+      }
+    }
+  EXPECT_EQ(far_checked, 6) << "the strays must have no neighbour near them";
+}
+
+TEST(FlockMeasures, PointsCoveredEqualsAllPairs) {
+  std::mt19937_64 rng(4);
+  long covered = 0, points = 0;
+  for (int p : {0, 1, 40, 2000})
+    for (double radius : {0.3, 1.5}) {
+      const VecX x = scattered(p, 20.0, rng);
+      std::vector<Vec2> q;
+      for (double a = -25; a <= 25; a += 0.5)
+        for (double b = -25; b <= 25; b += 0.5) q.emplace_back(a, b);
+      if (p > 0) q.emplace_back(x[0] + radius, x[2]);  // at the radius, up to rounding
+      const std::vector<char> got = points_covered(x, q, radius);
+      ASSERT_EQ(got.size(), q.size());
+      for (size_t k = 0; k < q.size(); ++k) {
+        bool want = false;
+        for (int i = 0; i < p && !want; ++i)
+          want = Vec2(x[3 * i] - q[k].x(), x[3 * i + 2] - q[k].y()).squaredNorm() <= radius * radius;
+        ASSERT_EQ(bool(got[k]), want) << "p " << p << " radius " << radius << " point " << k;
+        covered += want;
+      }
+      points += long(q.size());
+    }
+  EXPECT_GT(covered, 1000);
+  EXPECT_LT(covered, points / 2);
+}
+
+}  // namespace
+}  // namespace kf
