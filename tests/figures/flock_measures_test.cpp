@@ -7,23 +7,17 @@
 #include <random>
 
 #include "report/figure_measures.h"
+#include "../sim/random_flock.h"
 
 namespace kf {
 namespace {
-
-VecX scattered(int p, double box, std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> u(-box, box);
-  VecX x = VecX::Zero(3 * p);
-  for (int i = 0; i < p; ++i) x[3 * i] = u(rng), x[3 * i + 2] = u(rng);
-  return x;
-}
 
 TEST(FlockMeasures, NearestSpacingEqualsAllPairs) {
   std::mt19937_64 rng(3);
   int far_checked = 0;
   for (int p : {1, 2, 3, 50, 1500})
     for (double box : {0.2, 10.0, 300.0}) {
-      VecX x = scattered(p, box, rng);
+      VecX x = random_planar(p, box, rng);
       if (p > 10) {
         seg(x, 1) = seg(x, 0);                        // coincident: spacing 0
         seg(x, 2) = Vec3(50 * box, 0, -40 * box);     // a stray far beyond every other agent
@@ -51,7 +45,7 @@ TEST(FlockMeasures, PointsCoveredEqualsAllPairs) {
   long covered = 0, points = 0;
   for (int p : {0, 1, 40, 2000})
     for (double radius : {0.3, 1.5}) {
-      const VecX x = scattered(p, 20.0, rng);
+      const VecX x = random_planar(p, 20.0, rng);
       std::vector<Vec2> q;
       for (double a = -25; a <= 25; a += 0.5)
         for (double b = -25; b <= 25; b += 0.5) q.emplace_back(a, b);

@@ -10,16 +10,10 @@
 #include "adjoint/rollout.h"
 #include "sim/flock/flock_system.h"
 #include "sim/flock/neighbor_grid.h"
+#include "random_flock.h"
 
 namespace kf {
 namespace {
-
-VecX random_planar(int p, double scale, std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> u(-scale, scale);
-  VecX r = VecX::Zero(3 * p);
-  for (int i = 0; i < p; ++i) r[3 * i] = u(rng), r[3 * i + 2] = u(rng);
-  return r;
-}
 
 // phi = 1/2 sum over the watched agents of |x_N,i - target_i|^2: a few agents, so phi is O(1) and its
 // finite differences are not lost in the round-off of a sum over 10,000 agents.

@@ -10,16 +10,10 @@
 #include "sim/flock/matching_force.h"
 #include "sim/flock/neighbor_forces.h"
 #include "sim/flock/pair_index.h"
+#include "random_flock.h"
 
 namespace kf {
 namespace {
-
-VecX random_planar(int p, double scale, std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> u(-scale, scale);
-  VecX r = VecX::Zero(3 * p);
-  for (int i = 0; i < p; ++i) r[3 * i] = u(rng), r[3 * i + 2] = u(rng);
-  return r;
-}
 
 TEST(NeighborForces, EqualsTheSeparateTermsForwardAndTransposed) {
   const int p = 60;

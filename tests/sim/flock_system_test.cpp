@@ -8,6 +8,7 @@
 
 #include "adjoint/rollout.h"
 #include "sim/flock/flock_system.h"
+#include "random_flock.h"
 
 namespace kf {
 namespace {
@@ -20,13 +21,6 @@ FlockSpec small_flock(int agents = 20) {
   s.spawn.velocity = Vec3(0.8, 0, 0.2);
   s.wander.correlation_steps = 10;
   return s;
-}
-
-VecX random_planar(int p, double scale, std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> u(-scale, scale);
-  VecX r = VecX::Zero(3 * p);
-  for (int i = 0; i < p; ++i) r[3 * i] = u(rng), r[3 * i + 2] = u(rng);
-  return r;
 }
 
 // Largest |a - fd| relative to max(|fd|, floor x the largest fd entry).
