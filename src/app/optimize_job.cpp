@@ -309,7 +309,10 @@ void diagnose_run(const Scene& scene, JobResult& job, const EvaluationLog& elog,
     if (name == "effort") effort_end = value;
   const double final_keyframes = problem.last_diverged() ? final_objective : keyframe_terms(problem.breakdown());
   const std::vector<KeyframeJudgement> keyframes = judge_keyframes(scene, before.measures, report["measures"]);
-  const Sensitivity sensitivity = measure_sensitivity(scene, job.time);
+  // Under the run's checkpointing and budget: keeping every step of its gradient would hold the whole tape
+  // the run itself was checkpointed to avoid, after the run.
+  const Sensitivity sensitivity =
+      measure_sensitivity(scene, job.time, problem.checkpoint_every(), problem.memory_budget());
   RunFacts facts = run_facts(job.status, elog.history());
   facts.keyframe_objective_start = before.keyframes;
   facts.keyframe_objective_end = final_keyframes;

@@ -136,7 +136,8 @@ nlohmann::json Sensitivity::to_json() const {
           {"objective_relative_noise_start", relative_noise()}};
 }
 
-Sensitivity measure_sensitivity(const Scene& scene, const TimeSpec& time) {
+Sensitivity measure_sensitivity(const Scene& scene, const TimeSpec& time, int checkpoint_every,
+                                std::size_t memory_budget) {
   Sensitivity s;
   for (const auto& o : scene.objectives) s.keyframe = std::max(s.keyframe, o.frame);
   Scene probe = scene;
@@ -144,6 +145,8 @@ Sensitivity measure_sensitivity(const Scene& scene, const TimeSpec& time) {
   probe.controls.from_frame = 0;
   const auto sys = make_system(probe, time.h());
   Problem problem(probe, time, *sys);
+  if (checkpoint_every > 0) problem.set_checkpoint_every(checkpoint_every);
+  problem.set_memory_budget(memory_budget);
   const VecX z = problem.initial_guess();
   VecX g;
   s.phi = problem.evaluate(z, &g);

@@ -9,6 +9,7 @@
 // perturbation on its way to the keyframe (the gradient of φ with respect to a force held over each frame,
 // from one adjoint pass) and how noisy φ is under perturbations of 1e-9 (a bifurcation such as a flat sheet
 // released in its own plane).
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -61,7 +62,10 @@ struct Sensitivity {
 
 // Simulates the scene at `time` (its own system, built here) under per-frame force controls and takes one
 // gradient and six more evaluations of φ. Keyframes at frame 0 only: an empty gradient_by_frame.
-Sensitivity measure_sensitivity(const Scene& scene, const TimeSpec& time);
+// checkpoint_every and memory_budget (bytes) as the run's Problem takes them (0: the scene's spacing, no
+// limit), so the gradient holds no more memory than the run's own; the result is the same bit for bit.
+Sensitivity measure_sensitivity(const Scene& scene, const TimeSpec& time, int checkpoint_every = 0,
+                                std::size_t memory_budget = 0);
 
 // φ along the negative gradient at the point an optimisation stopped: at distances t = 1e-6 .. 1 times
 // φ / |g| (where the linear prediction φ - t |g| reaches 0), log-spaced. On smooth ground φ falls as its

@@ -41,6 +41,7 @@ class Problem : public StateCost {
   // Bytes the rollout of an evaluation with a gradient may hold (0: no limit): with checkpoint_every 0,
   // one whose estimate passes it is checkpointed (RolloutOptions::memory_budget). rollout().every tells.
   void set_memory_budget(std::size_t bytes) { memory_budget_ = bytes; }
+  std::size_t memory_budget() const { return memory_budget_; }
 
   // Values of each term (keyframe terms by name, then "effort") at the last evaluated point.
   const std::vector<std::pair<std::string, double>>& breakdown() const { return breakdown_; }

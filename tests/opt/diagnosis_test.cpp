@@ -50,6 +50,24 @@ TEST(Diagnosis, FlockShapesNeedInsideAndCoverageOnlyWhereCoverageIsAsked) {
   EXPECT_EQ(k[1].error_after, "inside 0.960");
 }
 
+TEST(Diagnosis, SensitivityIsTheSameUnderTheRunsCheckpointingAndBudget) {
+  const Scene scene = parse_scene(R"({"time": {"fps": 15, "substeps": 2, "frames": 12}, "flock": {"agents": 30},
+    "objectives": [{"type": "shape", "frame": 12, "polygon": [[-2, 6], [2, 6], [2, 10], [-2, 10]],
+                    "coverage": {"weight": 0.5}}]})",
+                                  "flock.json");
+  const Sensitivity all = measure_sensitivity(scene, scene.time);
+  ASSERT_EQ(all.gradient_by_frame.size(), 12u);
+  ASSERT_GT(all.gradient_by_frame.front(), 0.0);
+  // Every 5th step kept, and a budget of 1 kB (far below keeping every step: the rollout checkpoints).
+  for (const auto& [every, budget] : std::vector<std::pair<int, std::size_t>>{{5, 0}, {0, 1000}}) {
+    const Sensitivity s = measure_sensitivity(scene, scene.time, every, budget);
+    EXPECT_EQ(s.phi, all.phi);
+    EXPECT_EQ(s.phi_noise, all.phi_noise);
+    EXPECT_EQ(s.gradient_by_frame, all.gradient_by_frame) << "every " << every << ", budget " << budget;
+    EXPECT_EQ(s.to_json().dump(), all.to_json().dump());
+  }
+}
+
 std::vector<KeyframeJudgement> one_keyframe(double before, double after) {
   KeyframeJudgement k;
   k.name = "center_of_mass@24";
