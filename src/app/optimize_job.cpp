@@ -435,7 +435,9 @@ std::string set_up_stage(const JobContext& c, const StageSpec& stage, JobResult&
   // The first frame of the previous stage's forces (a resumed run's controls are the scene's).
   const int z_from_frame = job.problem ? job.problem->controls().first_frame() : c.scene.controls.from_frame;
   VecX v0_before;  // the initial velocities the previous stage's kind gave, when the kind changes
-  if (job.problem && job.problem->controls().kind() != std::string(control_kind_name(stage_scene.controls.kind)))
+  if (job.problem && job.problem->controls().forces())
+    z = job.problem->controls().per_particle_forces(z);  // what remap_from takes (a lattice spread out)
+  else if (job.problem && job.problem->controls().kind() != std::string(control_kind_name(stage_scene.controls.kind)))
     job.problem->controls().initial_velocity(z, v0_before);
   job.problem = std::make_unique<Problem>(stage_scene, job.time, *job.sys);
   Problem& problem = *job.problem;
