@@ -624,7 +624,12 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (!plan.why.empty() && !resuming) elog.say(plan.why);
   SignalGuard signals;
   const JobContext context{scene, opt, plan, dir, resuming, max_memory, all_evaluations, elog};
-  for (size_t s = 0; s < stages.size() && !job.interrupted; ++s) run_job_stage(context, stages, s, job, z_time);
+  for (size_t s = 0; s < stages.size() && !job.interrupted; ++s) {
+    run_job_stage(context, stages, s, job, z_time);
+    // A stage that converged or stalled early leaves its unspent evaluations to the next.
+    if (s + 1 < stages.size() && opt.max_evaluations < 0)
+      stages[s + 1].max_evaluations += std::max(0, stages[s].max_evaluations - job.stages.back().evaluations);
+  }
 
   nlohmann::json report;
   naming_run_dir(staged, [&] { report = write_run_report(work, scene, stages.size(), resuming, job, elog); });
