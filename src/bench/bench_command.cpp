@@ -58,13 +58,15 @@ void add_flock_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>&
       ->capture_default_str()->check(CLI::Range(0, 100000));
   auto* w = sub->add_option_group("crowd sweep (part of flock)");
   w->add_option("--crowd-scene", o->crowd.scene, "flock scene scaled to each size (spawn disc and shapes by "
-                "sqrt(agents / its agents), coverage terms dropped)")->capture_default_str();
+                "sqrt(agents / its agents), coverage terms dropped unless --crowd-coverage)")->capture_default_str();
   w->add_option("--crowd-agents", o->crowd.agents, "crowd sizes (empty: no crowd sweep)")
       ->capture_default_str()->delimiter(',')->check(CLI::Range(2, 10000000));
   w->add_option("--crowd-evaluations", o->crowd.evaluations, "evaluations of each crowd optimisation")
       ->capture_default_str()->check(CLI::Range(1, 100000));
   w->add_option("--crowd-budget-agents", o->crowd.budget_agents, "sizes run again under --crowd-budget")
       ->capture_default_str()->delimiter(',')->check(CLI::Range(2, 10000000));
+  w->add_flag("--crowd-coverage", o->crowd.coverage,
+              "keep the scene's coverage terms (shapes filled); results in flock_crowd_coverage.csv and its plots");
   w->add_option("--crowd-budget", o->crowd.budget_gb, "memory budget (GB) of those runs")
       ->capture_default_str()->check(CLI::Range(1e-6, 1e6));
 }

@@ -15,9 +15,13 @@ struct CrowdSweepOptions {
   // Sizes run again with a memory budget of budget_gb (GB), which switches checkpointing on.
   std::vector<int> budget_agents{10000};
   double budget_gb = 0.7;
+  // Keep the scene's coverage terms (shapes filled, not only entered); the results then go to
+  // flock_crowd_coverage.csv and its plots, the runs to <out>/crowd/square-N-coverage*.
+  bool coverage = false;
 };
 
-// Writes <out>/flock_crowd.csv, flock_crowd_time.png, flock_crowd_memory.png and the runs under <out>/crowd/
+// Writes <out>/flock_crowd.csv, flock_crowd_time.png, flock_crowd_memory.png (flock_crowd_coverage.* with
+// coverage kept) and the runs under <out>/crowd/
 // (`self` is this executable). Points run in the order given, budgeted ones after the others.
 nlohmann::json bench_crowd(const CrowdSweepOptions& o, const std::filesystem::path& out,
                            const std::filesystem::path& self);

@@ -144,12 +144,34 @@ TEST_F(GradcheckBenchCli, TinyFlockBenchWritesItsCsvPlotAndSummary) {
     EXPECT_EQ(row[0], "40");
     EXPECT_EQ(row[5], "2");           // evaluations
     EXPECT_GT(std::stod(row[8]), 1);  // peak MB of the child process
-    ASSERT_EQ(row.size(), 14u);
+    ASSERT_EQ(row.size(), 20u);
     EXPECT_GT(std::stod(row[13]), 0);  // CPU seconds of the child process
+    for (int c : {14, 15}) {           // coverage fractions of the square and the cross
+      EXPECT_GE(std::stod(row[c]), 0);
+      EXPECT_LE(std::stod(row[c]), 1);
+    }
+    EXPECT_GT(std::stod(row[16]), 0);  // the first evaluation's seconds
+    EXPECT_GT(std::stod(row[17]), 0);  // the last one's
+    EXPECT_GT(std::stod(row[18]), 0);  // neighbours per agent, uncontrolled
+    EXPECT_GT(std::stod(row[19]), 0);  // and optimised
   }
   EXPECT_EQ(crowd_rows[0][4], "0");
   EXPECT_GT(std::stoi(crowd_rows[1][4]), 1) << "the budget must switch checkpointing on";
   EXPECT_TRUE(summary["crowd"]["evaluation_exponent"].is_null()) << "one size has no slope";
+  std::ifstream dropped(dir_ / "b/crowd/square-40.json");
+  EXPECT_EQ(nlohmann::json::parse(dropped)["objectives"][0].count("coverage"), 0u);
+
+  // With coverage kept: its own table, the scaled scenes keep the terms.
+  const auto c = run_keyframe("bench --only flock --agents 20 --flock-frames 5 --flock-evaluations 1 --out c "
+                              "--crowd-scene " KEYFRAME_SOURCE_DIR "/scenes/square.json --crowd-agents 40 "
+                              "--crowd-evaluations 2 --crowd-coverage",
+                              dir_);
+  ASSERT_EQ(c.code, kExitOk) << c.output;
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "c/flock_crowd_coverage.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "c/flock_crowd_coverage_time.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "c/flock_crowd.csv"));
+  std::ifstream kept(dir_ / "c/crowd/square-40-coverage.json");
+  EXPECT_GT(nlohmann::json::parse(kept)["objectives"][0]["coverage"]["weight"].get<double>(), 0);
 }
 
 // The solver sweep on two tiny sheets: one column triple per solver and thread count, every cell measured
