@@ -438,7 +438,9 @@ std::string set_up_stage(const JobContext& c, const StageSpec& stage, JobResult&
   // The first frame of the previous stage's forces (a resumed run's controls are the scene's).
   const int z_from_frame = job.problem ? job.problem->controls().first_frame() : c.scene.controls.from_frame;
   VecX v0_before;  // the initial velocities the previous stage's kind gave, when the kind changes
-  if (job.problem && job.problem->controls().kind() != std::string(control_kind_name(stage_scene.controls.kind)))
+  if (job.problem && job.problem->controls().forces())
+    z = job.problem->controls().per_particle_forces(z);  // what remap_from takes (a lattice spread out)
+  else if (job.problem && job.problem->controls().kind() != std::string(control_kind_name(stage_scene.controls.kind)))
     job.problem->controls().initial_velocity(z, v0_before);
   job.problem = std::make_unique<Problem>(stage_scene, job.time, *job.sys);
   Problem& problem = *job.problem;
@@ -625,7 +627,12 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (!plan.why.empty() && !resuming) elog.say(plan.why);
   SignalGuard signals;
   const JobContext context{scene, opt, plan, dir, resuming, max_memory, all_evaluations, elog};
-  for (size_t s = 0; s < stages.size() && !job.interrupted; ++s) run_job_stage(context, stages, s, job, z_time);
+  for (size_t s = 0; s < stages.size() && !job.interrupted; ++s) {
+    run_job_stage(context, stages, s, job, z_time);
+    // A stage that converged or stalled early leaves its unspent evaluations to the next.
+    if (s + 1 < stages.size() && opt.max_evaluations < 0)
+      stages[s + 1].max_evaluations += std::max(0, stages[s].max_evaluations - job.stages.back().evaluations);
+  }
 
   nlohmann::json report;
   naming_run_dir(staged, [&] { report = write_run_report(work, scene, stages.size(), resuming, job, elog); });

@@ -3,7 +3,9 @@
 // one per particle per frame held over its substeps (Stuyck ch. 8), the initial velocities only, one
 // initial linear and angular velocity for the whole body (a thrown sheet needs six numbers, not 3p), or
 // initial velocities interpolated from a 3 x 3 lattice laid over the sheet (smooth: they bend the throw
-// without exciting the stiff springs between neighbours, which per-particle velocities do).
+// without exciting the stiff springs between neighbours, which per-particle velocities do), or per-frame
+// forces interpolated from the same lattice (a coarse stage before per-particle forces: its directions move
+// the sheet as a whole, where a per-particle gradient in contact is ruled by the few particles touching).
 // Ground-bound (planar) systems get no y components.
 #include <array>
 #include <utility>
@@ -21,9 +23,9 @@ class Controls {
   Controls(const ControlSpec& spec, const TimeSpec& time, int particles, bool planar, const VecX& x0_scene,
            const VecX& v0_scene);
 
-  int size() const {
-    return rigid_ ? 6 : lattice_ ? kLatticeNodes * int(comps_.size()) : blocks_ * particles_ * int(comps_.size());
-  }
+  int size() const { return rigid_ ? 6 : blocks_ * block_size(); }
+  // Force controls (per step, per frame, per frame on the lattice), not initial velocities.
+  bool forces() const { return kind_ != ControlKind::kInitialVelocity; }
   const char* kind() const { return control_kind_name(name_); }
   // The starting point of the optimisation: no force, or the scene's initial velocities.
   VecX initial_guess() const;
@@ -31,10 +33,15 @@ class Controls {
   void expand(const VecX& z, VecX& v0, std::vector<VecX>& U) const;
   // Chain rule back: dphi/dU and dphi/dv0 -> dphi/dz (overwrites dz).
   void gather(const std::vector<VecX>& dU, const VecX& dv0, VecX& dz) const;
+  // Force controls as one force per particle for each of their blocks (steps or frames): lattice forces
+  // spread over the particles; other kinds unchanged.
+  VecX per_particle_forces(const VecX& z) const;
   // Carries controls made for `from` (another substep count) whose forces began at frame `from_frame`
-  // over to this parameterisation: initial-velocity controls are unchanged; per-step forces are held over
-  // the nearest coarse step; frames the earlier controls did not reach get no force, frames they reached
-  // before this one's first frame are dropped (a window grown backwards starts where the last one ended).
+  // over to this parameterisation: initial-velocity controls are unchanged; force controls `z` come one
+  // force per particle per block (per_particle_forces) and per-step forces are held over the nearest
+  // coarse step; frames the earlier controls did not reach get no force, frames they reached before this
+  // one's first frame are dropped (a window grown backwards starts where the last one ended). Lattice
+  // forces are then the least-squares fit of each block.
   VecX remap_from(const VecX& z, const TimeSpec& from, int from_frame) const;
   // The first frame with a force (controls.from_frame, clamped; 0 for initial velocities).
   int first_frame() const { return first_step_ / substeps_; }
@@ -56,7 +63,8 @@ class Controls {
   double effort(const VecX& z, VecX& dz) const;
 
  private:
-  ControlKind name_, kind_;  // the scene's kind; how it behaves (rigid is a kind of initial_velocity)
+  ControlKind name_, kind_;  // the scene's kind; how it behaves (rigid is a kind of initial_velocity, lattice
+                             // forces of per_frame)
   double alpha_;
   int steps_, substeps_, frames_, particles_, blocks_;
   double h_;
@@ -64,20 +72,27 @@ class Controls {
   std::vector<int> comps_;  // which of x, y, z are controlled
   // The force block step n reads (-1: before first_step_, no force).
   int block_of(int n) const;
+  // Variables per block: one per node of the lattice or per particle, times the controlled components.
+  int block_size() const { return (lattice_ ? kLatticeNodes : particles_) * int(comps_.size()); }
+  // One block's values per particle (3p, controlled components only; others untouched) and the chain rule
+  // back (added into the block).
+  void spread(const double* block, VecX& per_particle) const;
+  void collect(const VecX& per_particle, double* block) const;
+  // The block that spreads closest (least squares) to per-particle values (3p); the lattice only.
+  void fit(const VecX& per_particle, double* block) const;
   VecX v0_scene_;
   // Rigid initial velocity: z = (Δv, ω), v0_i = v0_scene_i + Δv + ω × (x0_i − c); arms_ holds x0_i − c.
   bool rigid_ = false;
   VecX arms_;
   void rigid_velocity(const VecX& z, VecX& v0) const;
   void rigid_gather(const VecX& dv0, VecX& dz) const;
-  // Lattice initial velocity: v0_i = v0_scene_i + Σ_k w_ik z_k, bilinear over the kLatticeSide² nodes of a
-  // grid spanning the initial sheet's two widest principal axes; each particle's four (node, weight).
+  // Lattice: v0_i = v0_scene_i + Σ_k w_ik z_k (or a frame's force u_i = Σ_k w_ik z_k), bilinear over the
+  // kLatticeSide² nodes of a grid spanning the initial sheet's two widest principal axes; each particle's
+  // four (node, weight).
   static constexpr int kLatticeSide = 3, kLatticeNodes = kLatticeSide * kLatticeSide;
   bool lattice_ = false;
   std::vector<std::array<std::pair<int, double>, 4>> lattice_weights_;
   void lay_lattice(const VecX& x0_scene);
-  void lattice_velocity(const VecX& z, VecX& v0) const;
-  void lattice_gather(const VecX& dv0, VecX& dz) const;
 };
 
 }  // namespace kf

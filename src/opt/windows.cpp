@@ -19,15 +19,17 @@ int last_keyframe(const Scene& scene) {
   return scene.objectives.empty() ? scene.time.frames : std::min(last, scene.time.frames);
 }
 
-// Windows grown backwards from the last keyframe, sharing the budget equally.
+// Windows grown backwards from the last keyframe, sharing the budget equally. Per-frame forces act on the
+// 3 x 3 lattice in every window, then per particle over the last (the whole) window.
 std::vector<StageSpec> window_stages(const Scene& scene) {
   const OptimizerSpec& o = scene.optimizer;
   const ControlSpec& c = scene.controls;
+  const bool lattice = c.kind == ControlKind::kPerFrame;
   const int last = last_keyframe(scene);
   std::vector<int> starts;  // latest first: K - w, K - 2w, K - 4w, ... above from_frame, then from_frame
   for (long w = o.window_frames; last - w > c.from_frame; w *= 2) starts.push_back(int(last - w));
   starts.push_back(c.from_frame);
-  const int n = int(starts.size());
+  const int windows = int(starts.size()), n = windows + (lattice ? 1 : 0);
   const int part = std::max(1, o.max_evaluations / n);
   std::vector<StageSpec> stages;
   for (int k = 0; k < n; ++k) {
@@ -35,6 +37,7 @@ std::vector<StageSpec> window_stages(const Scene& scene) {
     if (k + 1 < n) {
       ControlSpec window = c;
       window.from_frame = starts[k];
+      if (lattice) window.kind = ControlKind::kPerFrameLattice;
       s.controls = window;
     }
     stages.push_back(s);
@@ -44,7 +47,8 @@ std::vector<StageSpec> window_stages(const Scene& scene) {
 
 std::string describe(const std::vector<StageSpec>& stages, int scene_from) {
   std::ostringstream os;
-  for (size_t k = 0; k < stages.size(); ++k)
+  const bool lattice = stages.front().controls && stages.front().controls->kind == ControlKind::kPerFrameLattice;
+  for (size_t k = 0; k + (lattice ? 1 : 0) < stages.size(); ++k)
     os << (k ? ", " : "") << (stages[k].controls ? stages[k].controls->from_frame : scene_from);
   return os.str();
 }
@@ -111,11 +115,18 @@ StagePlan plan_stages(const Scene& scene) {
   os.precision(2);
   os << "force gradient at the start grows " << plan.growth << "x from frame " << last - 1 << " back to frame "
      << c.from_frame;
-  if (plan.growth > o.window_growth) {
+  // Per-frame forces on a sheet that meets colliders or a body get windows whatever the growth at the start:
+  // the contact that makes a per-particle gradient rough may begin only later (a towel sliding off its rail).
+  const bool contact = c.kind == ControlKind::kPerFrame && (!scene.cloth->colliders.empty() || scene.character);
+  if (plan.growth > o.window_growth || contact) {
     plan.stages = window_stages(scene);
     plan.scaled_first_step = true;
-    os << " (above optimizer.window_growth " << o.window_growth << "): windows from frames "
+    if (plan.growth > o.window_growth) os << " (above optimizer.window_growth " << o.window_growth << ")";
+    else os << " (the sheet meets colliders)";
+    os << ": windows from frames "
        << describe(plan.stages, c.from_frame) << " to frame " << last;
+    if (c.kind == ControlKind::kPerFrame)
+      os << ", each on a 3 x 3 lattice of forces over the sheet, then one force per particle from frame " << c.from_frame;
   } else {
     os << " (not above optimizer.window_growth " << o.window_growth << "): one stage";
   }

@@ -5,10 +5,13 @@
 // keep each gradient short:
 //  - forces (per_step / per_frame), when the gradient at the start grows across the horizon by more than
 //    optimizer.window_growth (the largest frame's force gradient over that of the last frame before the
-//    last keyframe), act first over the last `window_frames` frames before the last keyframe, then over
+//    last keyframe), or per-frame forces on a sheet with colliders or a body at all, act first over the last `window_frames` frames before the last keyframe, then over
 //    windows twice, four times ... as long, down to controls.from_frame; each stage starts from the forces
-//    the last one found (new frames without force), so a longer window can only improve on it. A tame
-//    gradient (a sheet in free flight) keeps one stage.
+//    the last one found (new frames without force), so a longer window can only improve on it. Per-frame
+//    forces act on a 3 x 3 lattice over the sheet in every window, then per particle over the whole one:
+//    in contact a per-particle gradient is ruled by the few particles touching, and its line search stalls
+//    where a force on the sheet as a whole still moves it (a cape on a swinging body: 8.8 cm per particle,
+//    on target on the lattice). A tame gradient (a sheet in free flight) keeps one stage.
 //  - per-particle initial velocities start from the best rigid throw (six numbers; ring-toss.json's stages),
 //    found by a search over throws and then L-BFGS, bent by a 3 x 3 lattice of velocities over the sheet
 //    (27 numbers, smooth over it) before every particle gets its own.

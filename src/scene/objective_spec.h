@@ -70,11 +70,18 @@ inline const char* type_name(const ObjectiveSpec& o) {
 }
 
 // The control parameterisation (scene key controls.kind, named as in the scene file by control_kind_name).
-enum class ControlKind { kPerStep, kPerFrame, kInitialVelocity, kInitialRigidVelocity, kInitialLatticeVelocity };
+enum class ControlKind {
+  kPerStep,
+  kPerFrame,
+  kInitialVelocity,
+  kInitialRigidVelocity,
+  kInitialLatticeVelocity,
+  kPerFrameLattice  // per-frame forces interpolated from a 3 x 3 lattice over the sheet (a coarse stage)
+};
 
 inline const char* control_kind_name(ControlKind k) {
   constexpr const char* kNames[] = {"per_step", "per_frame", "initial_velocity", "initial_rigid_velocity",
-                                    "initial_lattice_velocity"};
+                                    "initial_lattice_velocity", "per_frame_lattice"};
   return kNames[int(k)];
 }
 

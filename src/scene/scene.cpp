@@ -165,13 +165,21 @@ ObjectiveSpec parse_objective(Block b, const Scene& s) {
   return o;
 }
 
-// `only_initial`: a schedule stage's controls, limited to the initial-velocity kinds; frames: the scene's.
-ControlSpec parse_controls(Block b, bool only_initial = false, int frames = 1) {
-  ControlSpec c;
-  if (only_initial) c.kind = ControlKind::kInitialRigidVelocity;
-  std::vector<ControlKind> kinds = {ControlKind::kInitialVelocity, ControlKind::kInitialRigidVelocity,
-                                    ControlKind::kInitialLatticeVelocity};
-  if (!only_initial) kinds.insert(kinds.begin(), {ControlKind::kPerStep, ControlKind::kPerFrame});
+// What a controls block may hold: the scene's own (every kind but lattice forces), a stage's before an
+// initial-velocity scene's last stage (the initial-velocity kinds), or a stage's before a per_frame scene's
+// last stage (per_frame or per_frame_lattice, from a frame). frames: the scene's.
+enum class ControlsBlock { kScene, kInitialStage, kForceStage };
+
+ControlSpec parse_controls(Block b, ControlsBlock where, int frames, const ControlSpec& defaults = {}) {
+  ControlSpec c = defaults;
+  std::vector<ControlKind> kinds;
+  if (where == ControlsBlock::kForceStage) {
+    kinds = {ControlKind::kPerFrame, ControlKind::kPerFrameLattice};
+  } else {
+    kinds = {ControlKind::kInitialVelocity, ControlKind::kInitialRigidVelocity, ControlKind::kInitialLatticeVelocity};
+    if (where == ControlsBlock::kScene) kinds.insert(kinds.begin(), {ControlKind::kPerStep, ControlKind::kPerFrame});
+    else c.kind = ControlKind::kInitialRigidVelocity;
+  }
   std::vector<std::string> names;
   for (ControlKind k : kinds) names.push_back(control_kind_name(k));
   const std::string kind = b.string("kind", control_kind_name(c.kind), names);
@@ -182,13 +190,14 @@ ControlSpec parse_controls(Block b, bool only_initial = false, int frames = 1) {
   // away with the effort 99 % of its objective).
   const bool initial = c.kind == ControlKind::kInitialVelocity || c.kind == ControlKind::kInitialRigidVelocity ||
                        c.kind == ControlKind::kInitialLatticeVelocity;
-  c.alpha = b.number("alpha", initial ? kInitialVelocityAlpha : c.alpha, 0.0, 1e6);
-  if (!only_initial) c.from_frame = b.integer("from_frame", 0, 0, std::max(0, frames - 1));
+  c.alpha = b.number("alpha", where == ControlsBlock::kForceStage ? c.alpha : initial ? kInitialVelocityAlpha : 1e-4,
+                     0.0, 1e6);
+  if (where != ControlsBlock::kInitialStage) c.from_frame = b.integer("from_frame", c.from_frame, 0, std::max(0, frames - 1));
   b.finish();
   return c;
 }
 
-OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls) {
+OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls, int frames) {
   OptimizerSpec o;
   o.max_evaluations = b.integer("max_evaluations", o.max_evaluations, 0, 1000000);
   o.ftol_rel = b.number("ftol_rel", o.ftol_rel, 0.0, 1.0);
@@ -201,12 +210,15 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls) {
     st.substeps = stage.integer("substeps", 1, 10000);
     st.max_evaluations = stage.integer("max_evaluations", st.max_evaluations, 0, 1000000);
     if (stage.has("controls")) {
-      // Only between the initial-velocity kinds: their controls carry over as the velocities they give,
-      // and the last stage is the scene's own kind (what the run's controls.bin holds).
-      if (scene_controls.kind != ControlKind::kInitialVelocity)
-        stage.fail("controls", "a stage's own controls only with the scene's controls.kind \"initial_velocity\"");
+      // Only between the initial-velocity kinds (their controls carry over as the velocities they give) or
+      // between per-frame forces and lattice forces (carried over as the forces they give); the last stage
+      // is the scene's own kind (what the run's controls.bin holds).
+      if (scene_controls.kind != ControlKind::kInitialVelocity && scene_controls.kind != ControlKind::kPerFrame)
+        stage.fail("controls", "a stage's own controls only with the scene's controls.kind \"initial_velocity\" or \"per_frame\"");
       if (k + 1 == stages.size()) stage.fail("controls", "the last stage uses the scene's controls (no \"controls\")");
-      st.controls = parse_controls(stage.child("controls"), true);
+      st.controls = scene_controls.kind == ControlKind::kPerFrame
+                        ? parse_controls(stage.child("controls"), ControlsBlock::kForceStage, frames, scene_controls)
+                        : parse_controls(stage.child("controls"), ControlsBlock::kInitialStage, frames);
     }
     stage.finish();
     o.schedule.push_back(st);
@@ -266,8 +278,8 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& file, Pa
   }
   if (root.has("character")) s.character = parse_character_spec(root.child("character"), s);
   for (Block& b : root.array("objectives")) s.objectives.push_back(parse_objective(std::move(b), s));
-  s.controls = parse_controls(root.child("controls"), false, s.time.frames);
-  s.optimizer = parse_optimizer(root.child("optimizer"), s.controls);
+  s.controls = parse_controls(root.child("controls"), ControlsBlock::kScene, s.time.frames);
+  s.optimizer = parse_optimizer(root.child("optimizer"), s.controls, s.time.frames);
   {
     Block b = root.child("render");
     s.render = parse_render_spec(b);

@@ -40,7 +40,8 @@ std::string flock_scene(int frames, int agents) {
     {"type": "shape", "frame": 10, "svg_path": {"file": "shape.svg"}}
   ],
   "controls": {"kind": "per_frame"},
-  "optimizer": {"schedule": [{"substeps": 1}], "first_step": 0.5},
+  "optimizer": {"schedule": [{"substeps": 1, "controls": {"kind": "per_frame_lattice", "from_frame": 1}}, {"substeps": 1}],
+                "first_step": 0.5},
   "render": {"camera": {"eye": [0, 5, 5], "target": [0, 0, 0]}}
 })";
 }

@@ -48,6 +48,64 @@ INSTANTIATE_TEST_SUITE_P(Controls, ProblemGradient,
                                            std::make_tuple("per_frame", 3), std::make_tuple("initial_velocity", 2),
                                            std::make_tuple("initial_rigid_velocity", 2)));
 
+// Lattice forces (a coarse stage's controls, never a scene's own): the adjoint's chain rule through the
+// lattice at perturbed controls, with 1 and 3 substeps.
+TEST(Problem, LatticeForcesGradientMatchesFiniteDifferences) {
+  for (int substeps : {1, 3}) {
+    Scene scene = toy_scene("per_frame", substeps, 2);
+    scene.controls.kind = ControlKind::kPerFrameLattice;
+    test::ToySystem sys(4, scene.time.h());
+    Problem problem(scene, scene.time, sys);
+    ASSERT_EQ(problem.size(), (12 - 2) * 9 * 3);
+    VecX z = problem.initial_guess() + 0.3 * VecX::Random(problem.size());
+    const GradcheckResult r = gradcheck(problem, z, {.samples = 60, .eps = 1e-3, .seed = 3});
+    ASSERT_GT(r.grad_norm, 1e-3);
+    EXPECT_GE(r.checked, 11);
+    EXPECT_LT(r.max_rel_error, 1e-6) << "substeps " << substeps << ", cosine " << r.cosine;
+  }
+}
+
+// A lattice stage's forces carried into the per-particle stage after it: the particles feel the same force
+// at every step and the effort is the same; carried back, the lattice's own values return (least squares of
+// a field the lattice spans). A 5 x 5 sheet so every node has particles around it.
+TEST(Problem, LatticeForcesCarryOverToPerParticleForcesExactly) {
+  TimeSpec t;
+  t.fps = 10, t.substeps = 2, t.frames = 6;
+  VecX x0(3 * 25);
+  for (int j = 0; j < 5; ++j)
+    for (int i = 0; i < 5; ++i) x0.segment<3>(3 * (5 * j + i)) = Vec3(0.1 * i, 1.0, 0.2 * j);
+  ControlSpec lattice_spec, particle_spec;
+  lattice_spec.kind = ControlKind::kPerFrameLattice;
+  particle_spec.kind = ControlKind::kPerFrame;
+  lattice_spec.from_frame = particle_spec.from_frame = 2;
+  const Controls lattice(lattice_spec, t, 25, false, x0, VecX::Zero(75));
+  const Controls particles(particle_spec, t, 25, false, x0, VecX::Zero(75));
+  ASSERT_EQ(lattice.size(), 4 * 9 * 3);
+  const VecX zl = VecX::LinSpaced(lattice.size(), -1, 2);
+  const VecX zp = particles.remap_from(lattice.per_particle_forces(zl), t, 2);
+  ASSERT_EQ(zp.size(), particles.size());
+  VecX ul, up;
+  for (int n = 0; n < t.steps(); ++n) {
+    lattice.force_at(zl, n, ul);
+    particles.force_at(zp, n, up);
+    EXPECT_LT((ul - up).lpNorm<Eigen::Infinity>(), 1e-14) << "step " << n;
+  }
+  VecX gl = VecX::Zero(lattice.size()), gp = VecX::Zero(particles.size());
+  EXPECT_NEAR(lattice.effort(zl, gl), particles.effort(zp, gp), 1e-12);
+  const VecX back = lattice.remap_from(zp, t, 2);
+  EXPECT_LT((back - zl).lpNorm<Eigen::Infinity>(), 1e-9);
+  // A window grown backwards on the lattice: the new frames start without force.
+  ControlSpec earlier = lattice_spec;
+  earlier.from_frame = 0;
+  const Controls grown(earlier, t, 25, false, x0, VecX::Zero(75));
+  const VecX zg = grown.remap_from(lattice.per_particle_forces(zl), t, 2);
+  for (int n = 0; n < t.steps(); ++n) {
+    grown.force_at(zg, n, up);
+    lattice.force_at(zl, n, ul);
+    EXPECT_LT((ul - up).lpNorm<Eigen::Infinity>(), 1e-9) << "step " << n;
+  }
+}
+
 TEST(Problem, PerFrameForcesAreHeldOverSubsteps) {
   Scene scene = toy_scene("per_frame", 4);
   test::ToySystem sys(4, scene.time.h());

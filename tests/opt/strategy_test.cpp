@@ -86,7 +86,10 @@ TEST(Strategy, ClothForcesGrowWindowsBackwardsFromTheLastKeyframe) {
   const Scene scene = strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"max_evaluations": 300, "window_growth": 1})");
   const StagePlan plan = plan_stages(scene);
   EXPECT_GT(plan.growth, 1);
-  EXPECT_EQ(window_starts(plan.stages, 0), (std::vector<int>{23, 18, 8, 0}));
+  // Per-frame forces: each window on the lattice, then per particle over the whole horizon.
+  EXPECT_EQ(window_starts(plan.stages, 0), (std::vector<int>{23, 18, 8, 0, 0}));
+  for (size_t k = 0; k + 1 < plan.stages.size(); ++k)
+    EXPECT_EQ(plan.stages[k].controls->kind, ControlKind::kPerFrameLattice) << "stage " << k;
   int budget = 0;
   for (const auto& s : plan.stages) {
     budget += s.max_evaluations;
@@ -95,10 +98,14 @@ TEST(Strategy, ClothForcesGrowWindowsBackwardsFromTheLastKeyframe) {
   EXPECT_EQ(budget, 300);
   EXPECT_FALSE(plan.stages.back().controls);  // the last stage optimises the scene's own controls
   EXPECT_TRUE(plan.scaled_first_step);
-  EXPECT_NE(plan.why.find("windows from frames 23, 18, 8, 0 to frame 28"), std::string::npos) << plan.why;
+  EXPECT_NE(plan.why.find("windows from frames 23, 18, 8, 0 to frame 28, each on a 3 x 3 lattice"), std::string::npos)
+      << plan.why;
+  // Per-step forces have no lattice: their windows are per particle.
   const Scene late = strategy_scene(kCloth, R"({"kind": "per_step", "from_frame": 20})",
                                     R"({"window_frames": 3, "window_growth": 1})");
-  EXPECT_EQ(window_starts(plan_stages(late).stages, 20), (std::vector<int>{25, 22, 20}));
+  const StagePlan late_plan = plan_stages(late);
+  EXPECT_EQ(window_starts(late_plan.stages, 20), (std::vector<int>{25, 22, 20}));
+  EXPECT_EQ(late_plan.stages.front().controls->kind, ControlKind::kPerStep);
   // The same scene below its threshold: one stage.
   const Scene tame = strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"window_growth": 1e12})");
   const StagePlan one = plan_stages(tame);

@@ -132,6 +132,27 @@ TEST_P(ClothExactAdjoint, MatchesFiniteDifferencesAtEveryStepAndPerturbation) {
   }
 }
 
+// Forces on the 3 x 3 lattice (a coarse stage before per-particle forces): the chain rule through the
+// lattice, in contact (a pinned sheet on a sphere, a sheet sliding with friction) at perturbed controls.
+TEST(ClothExactAdjointLattice, LatticeForcesMatchFiniteDifferencesInContact) {
+  for (const Case& c : kCases) {
+    const std::string name = c.name;
+    if (name != "sphere_pinned_frictionless" && name != "ground_sliding") continue;
+    for (int substeps : {1, 4}) {
+      Scene scene = scene_of(c, substeps);
+      scene.controls.kind = ControlKind::kPerFrameLattice;
+      auto sys = make_system(scene);
+      Problem problem(scene, scene.time, *sys);
+      ASSERT_EQ(problem.size(), 3 * 9 * 3);
+      test::gradcheck_perturbed(problem, c.eps, {0.0, 0.01, 0.1}, [&](double perturb, const GradcheckResult& r) {
+        ASSERT_GT(r.grad_norm, 0) << name;
+        EXPECT_GE(r.checked, 14) << name;
+        EXPECT_LE(r.max_rel_error, 1e-6) << name << " h = 1/" << 30 * substeps << " perturb " << perturb;
+      });
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(SmallScenes, ClothExactAdjoint, ::testing::ValuesIn([] {
                            std::vector<const Case*> v;
                            for (const Case& c : kCases) v.push_back(&c);
