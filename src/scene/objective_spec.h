@@ -131,7 +131,7 @@ struct OptimizerSpec {
   // the scene's controls in one stage.
   std::string strategy = "auto";
   int window_frames = 5;  // the first window's length in frames; each next window is twice as long
-  double window_growth = 1e3;  // windows only when the start's force gradient grows more than this
+  double window_growth = 1e3;  // windows when the start's force gradient grows more than this (or in contact: opt/windows.h)
   // RMS change per control variable of L-BFGS's first trial step (N for forces, m/s for velocities); a
   // steeper start is scaled down to it. < 0: automatic (the mean particle's weight, or 1 m/s); 0: off.
   double first_step = -1;
