@@ -122,7 +122,7 @@ StagePlan plan_stages(const Scene& scene) {
     plan.stages = window_stages(scene);
     plan.scaled_first_step = true;
     if (plan.growth > o.window_growth) os << " (above optimizer.window_growth " << o.window_growth << ")";
-    else os << " (the sheet meets colliders)";
+    else os << " (the sheet meets colliders or a body)";
     os << ": windows from frames "
        << describe(plan.stages, c.from_frame) << " to frame " << last;
     if (c.kind == ControlKind::kPerFrame)
