@@ -162,6 +162,10 @@ def make(n, frames, key_frames, keyed, max_evaluations):
                   # that the rigid stage stalls and the second stage's gradient is useless
                   # (tests/results/runs/ring-toss/stage_gradients.csv).
                   "buckle_stiffness": 0.3,
+                  # A sheet thrown exactly flat is a bifurcation: which way it first buckles is round-off's
+                  # choice, so the objective is noise at 1e-3 of itself and per-particle gradients are 1e7..1e10.
+                  # Half a millimetre of seeded waviness decides it (tests/results/runs/ring-toss/README.md).
+                  "imperfection": 5e-4,
                   # The uniform throw the rigid stage starts from (its effort is measured from it).
                   "velocity": r4(v0),
                   # At 1e-6 the 50x50 rigid stage stalls on the solver's noise; at 1e-9 it keeps descending
@@ -175,10 +179,9 @@ def make(n, frames, key_frames, keyed, max_evaluations):
                        "stiffness": 1000.0}]},
         "objectives": objectives,
         "controls": {"kind": "initial_velocity", "alpha": 1e-6},
-        "optimizer": {"ftol_rel": 1e-10, "schedule": [
-            {"substeps": 2, "max_evaluations": max_evaluations[0],
-             "controls": {"kind": "initial_rigid_velocity", "alpha": 1e-5}},
-            {"substeps": 2, "max_evaluations": max_evaluations[1]}]},
+        # The default plan: the throw fitted to the keyframes and a search over throws, the rigid throw, a
+        # lattice of initial velocities, then one per particle.
+        "optimizer": {"ftol_rel": 1e-10, "max_evaluations": max_evaluations},
         "render": {"camera": {"eye": [0.6, 1.5, 4.4], "target": [0.6, 0.75, 0]}},  # the whole flight, side on
     }
     return scene, summary
@@ -196,9 +199,9 @@ def dump(path, scene):
 
 
 if __name__ == "__main__":
-    full, s = make(50, 28, [5, 14, 21], 8, (40, 10))
+    full, s = make(50, 28, [5, 14, 21], 8, 120)
     print(s)
     dump("scenes/ring-toss.json", full)
-    small, s = make(12, 28, [5, 14, 21], 4, (25, 20))
+    small, s = make(12, 28, [5, 14, 21], 4, 45)
     print(s)
     dump("tests/figures/ring-toss-small.json", small)

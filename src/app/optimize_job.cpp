@@ -25,6 +25,7 @@
 #include "opt/diagnosis.h"
 #include "report/figure_measures.h"
 #include "opt/optimizer.h"
+#include "opt/throw_fit.h"
 #include "opt/throw_search.h"
 #include "opt/windows.h"
 #include "scene/reach_check.h"
@@ -526,9 +527,11 @@ bool rehold_split_schedule(JobResult& job, const VecX& z, double& phi) {
 // while the throws differ, then the best one's split pattern is held. Deterministic, so a resume that
 // replays the run's evaluations searches again and starts where the run did.
 void search_throws_first(const JobContext& c, JobResult& job) {
+  constexpr int kThrowCorrections = 3;  // four flights, a small share of the search
   if (ClothSystem* cloth = cloth_of(*job.sys)) cloth->release_schedule();
   const auto t0 = std::chrono::steady_clock::now();
-  const ThrowSearch found = search_throws(*job.problem, c.plan.throw_search);
+  const ThrowSearch found =
+      search_throws(*job.problem, c.plan.throw_search, refine_fitted_throw(*job.problem, c.scene, kThrowCorrections));
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::ostringstream os;
   os << std::setprecision(3) << "throw search: " << found.simulated << " rigid throws simulated (speeds within "
@@ -536,9 +539,14 @@ void search_throws_first(const JobContext& c, JobResult& job) {
      << std::setprecision(2) << seconds << " s; " << std::scientific << std::setprecision(3);
   if (found.phi < found.start_phi) os << "the best has objective " << found.phi << ", the scene's throw " << found.start_phi;
   else os << "none beats the scene's throw (objective " << found.start_phi << ")";
+  if (!found.fitted.empty()) {
+    os << "; the throw fitted to the keyframes " << found.fitted.front();
+    for (size_t k = 1; k < found.fitted.size(); ++k) os << (k == 1 ? ", corrected " : ", ") << found.fitted[k];
+  }
   c.elog.say(os.str());
   job.throw_search = {{"throws", found.simulated}, {"speed_range", found.speed}, {"spin_range", found.spin},
                       {"start_objective", found.start_phi}, {"best_objective", found.phi},
+                      {"fitted_objectives", found.fitted},
                       {"best_throw", std::vector<double>(found.z.data(), found.z.data() + found.z.size())},
                       {"seconds", seconds}};
   job.z = found.z;

@@ -26,7 +26,7 @@ int automatic_throw_count(int particles, int steps) {
   return int(std::clamp(4e6 / per_throw, 32.0, 512.0));
 }
 
-ThrowSearch search_throws(Problem& problem, int count) {
+ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted) {
   if (problem.controls().kind() != std::string("initial_rigid_velocity"))
     throw std::logic_error("search_throws: the problem's controls are not a rigid throw");
   VecX x0, v0;
@@ -49,9 +49,12 @@ ThrowSearch search_throws(Problem& problem, int count) {
   s.z = VecX::Zero(6);
   s.start_phi = s.phi = problem.evaluate(s.z, nullptr);
   if (problem.last_diverged()) s.phi = INFINITY;
-  // Four rounds of a quarter of the throws each: the throw's velocity alone (a spinning sheet rarely lands
-  // where a flat one would), then velocity and spin together in boxes half, a quarter and an eighth as wide
-  // around the best so far.
+  s.fitted = fitted.flown;
+  if (fitted.z && fitted.phi < s.phi) s.phi = fitted.phi, s.z = *fitted.z;
+  s.simulated += fitted.simulated;
+  // Four rounds of a quarter of the throws each: the throw's velocity alone, its spin kept (a spinning sheet
+  // rarely lands where a flat one would), then velocity and spin together in boxes half, a quarter and an
+  // eighth as wide around the best so far.
   constexpr int kPrimes[6] = {2, 3, 5, 7, 11, 13};
   constexpr int kRounds = 4;
   VecX z(6);

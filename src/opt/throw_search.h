@@ -3,9 +3,11 @@
 // no gradient leaves: a towel that misses its rail lies on the ground under it, as near the target as it
 // gets there, and every small change of the throw leaves it lying there. The search simulates throws spread
 // evenly over a box around the scene's own (a Halton sequence: the same throws on every run), forward only,
-// and the rigid stage starts from the best of them and the scene's throw.
+// and the rigid stage starts from the best of them, the scene's throw and the throw fitted to the keyframes
+// (opt/throw_fit.h); the boxes after the first are centred on the best so far.
 #include "core/types.h"
 #include "opt/problem.h"
+#include "opt/throw_fit.h"
 
 namespace kf {
 
@@ -13,7 +15,8 @@ struct ThrowSearch {
   VecX z;                  // the best rigid controls (Δv, ω); zero: the scene's throw was best
   double phi = 0;          // their objective
   double start_phi = 0;    // the scene's throw's
-  int simulated = 0;       // throws simulated besides the scene's
+  int simulated = 0;       // throws simulated besides the scene's (the fitted one among them)
+  std::vector<double> fitted;  // the objectives of the fitted throw and its corrections (opt/throw_fit.h)
   double speed = 0;        // the box's half-width in Δv (m/s)
   double spin = 0;         // and in ω (rad/s)
 };
@@ -24,6 +27,7 @@ int automatic_throw_count(int particles, int steps);
 
 // `problem` must have initial_rigid_velocity controls. The box: Δv within ±max(1 m/s, half the scene's mean
 // initial speed) on each axis, ω within ± that over the sheet's RMS radius (rim speeds alike).
-ThrowSearch search_throws(Problem& problem, int count);
+// `fitted` (refine_fitted_throw's, already flown) competes with the others and counts among the simulated.
+ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted = {});
 
 }  // namespace kf
