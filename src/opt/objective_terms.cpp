@@ -76,14 +76,17 @@ class CenterOfMassTerm : public ObjectiveTerm {
 // m = 0 this is ½w Σ dist(x_i, S)² over agents outside. The gradient w (s + m) ∇s is continuous across the
 // boundary (∇s is the unit direction away from the closest boundary point, outward).
 // Agents into a polygon on the ground: ½w Σ s_i² with s_i the distance outside the region (plus a margin
-// inside the boundary when margin > 0). With coverage, the region filled too: ½w_c Σ_j max(0, D_j − r²)²
+// inside the boundary when margin > 0). With coverage, the region filled too: ½w_c Σ_j (2r max(0, √D_j − r))²
 // over the region samples q_j, with D_j a soft minimum of the squared distances ‖q_j − x_i‖² (log-sum-exp
-// at temperature (r/4)², smooth where the nearest agent changes).
+// at temperature (r/4)², smooth where the nearest agent changes). Measured in distance, like the inside
+// term, a sample's penalty grows with the square of its gap, so the two keep their balance when a shape and
+// its crowd are scaled up together (samples and agents both grow with the area); the factor 2r makes it
+// (D_j − r²)² to first order where a gap closes (D_j → r²), so a weight keeps its meaning there.
 class ShapeTerm : public ObjectiveTerm {
  public:
   ShapeTerm(const ObjectiveSpec& s, const ShapeKeyframe& k, int p)
       : frame_(s.frame), w_(s.weight), margin_(k.margin), ids_(members(s, p)), region_(k.polygon, k.holes),
-        wc_(k.coverage_weight), r2_(k.coverage_radius * k.coverage_radius), tau_(r2_ / 16),
+        wc_(k.coverage_weight), r_(k.coverage_radius), r2_(r_ * r_), tau_(r2_ / 16),
         samples_(k.coverage_weight > 0 ? region_samples(region_, k.coverage_spacing) : std::vector<Vec2>{}) {}
   std::string name() const override { return "shape"; }
   int frame() const override { return frame_; }
@@ -132,16 +135,18 @@ class ShapeTerm : public ObjectiveTerm {
     tree_.within(q, nearest + kSoftCut * tau_, near_);  // in member order, the order of summing over all
     double sum = 0;
     for (const auto& f : near_) sum += std::exp(-(f.squared - nearest) / tau_);
-    const double soft = nearest - tau_ * std::log(sum), h = soft - r2_;
-    if (h <= 0) return 0;
+    const double soft = nearest - tau_ * std::log(sum);
+    if (soft - r2_ <= 0) return 0;
+    const double root = std::sqrt(soft), gap = root - r_;  // metres beyond r
+    const double dphi_dsoft = 4 * wc_ * r2_ * gap / (2 * root);
     for (const auto& f : near_) {
       const int i = ids_[f.index];
       const double dsoft = std::exp(-(f.squared - nearest) / tau_) / sum;  // ∂D/∂d²_i
-      const double c = wc_ * h * dsoft * 2;
+      const double c = dphi_dsoft * dsoft * 2;
       gx[3 * i] += c * (x[3 * i] - q.x());
       gx[3 * i + 2] += c * (x[3 * i + 2] - q.y());
     }
-    return 0.5 * wc_ * h * h;
+    return 2 * wc_ * r2_ * gap * gap;
   }
 
   static constexpr double kSoftCut = 50;
@@ -149,7 +154,7 @@ class ShapeTerm : public ObjectiveTerm {
   double w_, margin_;
   std::vector<int> ids_;
   GroundRegion region_;  // before samples_, which are read from it
-  double wc_, r2_, tau_;
+  double wc_, r_, r2_, tau_;
   std::vector<Vec2> samples_;
   // The members' (x, z) at the evaluated frame and one sample's nearby members: rebuilt by each evaluation,
   // reused by every sample (evaluations are sequential).

@@ -36,7 +36,8 @@ struct ShapeKeyframe {
   double margin = 0;          // metres
   // Filling the region: every point of a grid of `spacing` inside the polygon should have an agent within
   // `radius` (default: the flock's avoidance radius; spacing default radius / 2). `coverage_weight` 0 leaves
-  // the term off; the figure measure coverage_fraction uses radius and spacing either way.
+  // the term off; the figure measure coverage_fraction uses radius and spacing either way. The penalty of a
+  // point is ½w (2r (d − r))², d its distance to the nearest agent (softened): in m², like the inside term's.
   double coverage_weight = 0;
   double coverage_radius = 0;   // metres
   double coverage_spacing = 0;  // metres

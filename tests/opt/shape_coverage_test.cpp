@@ -18,8 +18,8 @@
 namespace kf {
 namespace {
 
-// ½w_c Σ_j max(0, D_j − r²)², D_j the soft minimum over every agent (the term as first written: each sample
-// against all agents); adds its gradient to gx. `uncovered` counts the samples with no agent within r.
+// ½w_c Σ_j (2r max(0, √D_j − r))², D_j the soft minimum over every agent (each sample against all agents);
+// adds its gradient to gx. `uncovered` counts the samples with no agent within r.
 double coverage_over_all_agents(const ShapeKeyframe& k, const VecX& x, VecX& gx, int& uncovered) {
   const int p = int(x.size() / 3);
   const double r2 = k.coverage_radius * k.coverage_radius, tau = r2 / 16;
@@ -36,14 +36,16 @@ double coverage_over_all_agents(const ShapeKeyframe& k, const VecX& x, VecX& gx,
     ++uncovered;
     double sum = 0;
     for (int i = 0; i < p; ++i) sum += std::exp(-(d2[i] - nearest) / tau);
-    const double h = nearest - tau * std::log(sum) - r2;
-    if (h <= 0) continue;
-    for (int i = 0; i < p; ++i) {
-      const double c = k.coverage_weight * h * std::exp(-(d2[i] - nearest) / tau) / sum * 2;
+    const double soft = nearest - tau * std::log(sum);
+    if (soft <= r2) continue;
+    const double gap = std::sqrt(soft) - k.coverage_radius, scaled = 2 * k.coverage_radius * gap;
+    for (int i = 0; i < p; ++i) {  // ∂/∂x_i of ½w (2r gap)², gap = √D − r
+      const double c = k.coverage_weight * scaled * 2 * k.coverage_radius / (2 * std::sqrt(soft)) *
+                       std::exp(-(d2[i] - nearest) / tau) / sum * 2;
       gx[3 * i] += c * (x[3 * i] - q.x());
       gx[3 * i + 2] += c * (x[3 * i + 2] - q.y());
     }
-    val += 0.5 * k.coverage_weight * h * h;
+    val += 0.5 * k.coverage_weight * scaled * scaled;
   }
   return double(val);
 }
