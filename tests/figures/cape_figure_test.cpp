@@ -98,7 +98,7 @@ TEST(CapeFigure, BlendEndsFarCloserToClipBThanTheUncontrolledCape) {
 // uncontrolled), velocity errors at most 0.63 of the uncontrolled; 160 evaluations left the worst run where
 // it was. So the bars here are what the reduced run meets on every one of those rounding variants; the
 // figure's own bars (0.5 %, a quarter of the velocity error) are met by the full run, whose report is
-// tests/results/runs/cape-blend/report.json (0.14 %). Without optimisation (max_evaluations 0) the position
+// tests/results/runs/cape-blend/report.json (0.17 %). Without optimisation (max_evaluations 0) the position
 // and velocity checks fail.
 TEST(CapeFigure, BlendFromTheStuntFallEndsNearTheCalmTakesPositionsAndVelocities) {
   test::TempDir dir;

@@ -160,10 +160,8 @@ TEST(FullFigures, RingTossThroughTheRing) {
 
 // Clip A's cape state steered into clip B's: forces over at least 20 frames, end RMS position error at most
 // 0.5 % of the cape's length, velocity error at most a quarter of the uncontrolled one, within 10 minutes.
-// Disabled: the shipped blend steers its last 5 frames only, and steered from frame 10 it ended at 1.27 % and
-// 0.61x the uncontrolled velocity error (tests/results/robustness/strategy_figures.csv), short of both bars.
-// Run it with --gtest_also_run_disabled_tests; enable it when the blend meets its bars.
-TEST(FullFigures, DISABLED_CapeBlendEndsInClipBsState) {
+// The shipped blend steers its last 20 frames in windows grown back from the end (scenes/cape-blend.json).
+TEST(FullFigures, CapeBlendEndsInClipBsState) {
   test::TempDir dir;
   const fs::path source(KEYFRAME_SOURCE_DIR);
   // Copies of the scenes in the test's directory (the blend reads ../out/cape-a and ../out/cape-b beside it),
