@@ -48,19 +48,17 @@ Vec3 rotation_vector(const Mat3& r) {
   return aa.axis() * aa.angle();
 }
 
-}  // namespace
-
-std::optional<VecX> fit_throw(const Scene& scene, const VecX& x0, const VecX& v0, const Rollout* flown) {
-  if (!scene.cloth) return std::nullopt;
+// What each keyframe frame says of the sheet's pose: from the targets, or (flown given) from where the
+// flown sheet has the keyframes' particles.
+std::map<int, Pose> keyframe_poses(const Scene& scene, const VecX& x0, const Rollout* flown) {
   const int particles = int(x0.size() / 3);
   std::vector<int> all(particles);
   for (int i = 0; i < particles; ++i) all[i] = i;
-  const Vec3 c0 = centroid(x0, all), v_mean = centroid(v0, all);
+  const Vec3 c0 = centroid(x0, all);
   // Where particle i is at a keyframe: `flown`'s state at the keyframe's frame, else the target t.
   const auto at = [&](int frame, int i, const Vec3& t) -> Vec3 {
     return flown ? Vec3(flown->x[size_t(frame) * scene.time.substeps].segment<3>(3 * i)) : t;
   };
-
   std::map<int, Pose> poses;  // by frame; a later keyframe on the same frame refines the first
   for (const ObjectiveSpec& o : scene.objectives) {
     const std::vector<int>& ids = o.particles.empty() ? all : o.particles;
@@ -93,6 +91,18 @@ std::optional<VecX> fit_throw(const Scene& scene, const VecX& x0, const VecX& v0
                           [](const auto&) {}},
                o.kind);
   }
+  return poses;
+}
+
+}  // namespace
+
+std::optional<VecX> fit_throw(const Scene& scene, const VecX& x0, const VecX& v0, const Rollout* flown) {
+  if (!scene.cloth) return std::nullopt;
+  const int particles = int(x0.size() / 3);
+  std::vector<int> all(particles);
+  for (int i = 0; i < particles; ++i) all[i] = i;
+  const Vec3 c0 = centroid(x0, all), v_mean = centroid(v0, all);
+  std::map<int, Pose> poses = keyframe_poses(scene, x0, flown);
   poses.erase(0);
   if (poses.empty()) return std::nullopt;
 
