@@ -19,8 +19,11 @@ int last_keyframe(const Scene& scene) {
   return scene.objectives.empty() ? scene.time.frames : std::min(last, scene.time.frames);
 }
 
-// Windows grown backwards from the last keyframe, sharing the budget equally. Per-frame forces act on the
-// 3 x 3 lattice in every window, then per particle over the last (the whole) window.
+// Windows grown backwards from the last keyframe. The first (shortest) window gets half the budget, the
+// others share the rest equally: its gradient is the only tame one, so it does most of the work and is still
+// descending at an equal share, while longer windows mostly stall within a few evaluations and pass their
+// unspent budget on. Per-frame forces act on the 3 x 3 lattice in every window, then per particle over the
+// last (the whole) window.
 std::vector<StageSpec> window_stages(const Scene& scene) {
   const OptimizerSpec& o = scene.optimizer;
   const ControlSpec& c = scene.controls;
@@ -30,10 +33,12 @@ std::vector<StageSpec> window_stages(const Scene& scene) {
   for (long w = o.window_frames; last - w > c.from_frame; w *= 2) starts.push_back(int(last - w));
   starts.push_back(c.from_frame);
   const int windows = int(starts.size()), n = windows + (lattice ? 1 : 0);
-  const int part = std::max(1, o.max_evaluations / n);
+  const int first = n > 1 ? std::max(1, o.max_evaluations / 2) : o.max_evaluations;
+  const int part = n > 1 ? std::max(1, (o.max_evaluations - first) / (n - 1)) : 0;
   std::vector<StageSpec> stages;
   for (int k = 0; k < n; ++k) {
-    StageSpec s{scene.time.substeps, k + 1 < n ? part : std::max(1, o.max_evaluations - part * (n - 1)), std::nullopt};
+    const int budget = k == 0 ? first : k + 1 < n ? part : std::max(1, o.max_evaluations - first - part * (n - 2));
+    StageSpec s{scene.time.substeps, budget, std::nullopt};
     if (k + 1 < n) {
       ControlSpec window = c;
       window.from_frame = starts[k];

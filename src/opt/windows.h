@@ -5,8 +5,9 @@
 // keep each gradient short:
 //  - forces (per_step / per_frame), when the gradient at the start grows across the horizon by more than
 //    optimizer.window_growth (the largest frame's force gradient over that of the last frame before the
-//    last keyframe), or per-frame forces on a sheet with colliders or a body at all, act first over the last `window_frames` frames before the last keyframe, then over
-//    windows twice, four times ... as long, down to controls.from_frame; each stage starts from the forces
+//    last keyframe), or per-frame forces on a sheet with colliders or a body at all, act first over the
+//    last `window_frames` frames before the last keyframe (with half the evaluations), then over windows
+//    twice, four times ... as long, down to controls.from_frame; each stage starts from the forces
 //    the last one found (new frames without force), so a longer window can only improve on it. Per-frame
 //    forces act on a 3 x 3 lattice over the sheet in every window, then per particle over the whole one:
 //    in contact a per-particle gradient is ruled by the few particles touching, and its line search stalls

@@ -77,8 +77,9 @@ struct ClothSpec {
   Vec3 gravity = Vec3(0, -9.81, 0);     // m/s^2
   Vec3 velocity = Vec3::Zero();         // initial velocity of every free particle, m/s
   // Seeded out-of-plane offsets of the initial sheet, uniform in [-imperfection, imperfection] metres,
-  // which the springs take as their rest shape (sim/cloth/imperfection.h); 0: exactly flat.
-  double imperfection = 0;
+  // which the springs take as their rest shape (sim/cloth/imperfection.h); 0: exactly flat. On by default:
+  // an exactly flat, symmetric sheet is a bifurcation whose gradient is round-off (opt/windows.h).
+  double imperfection = 5e-4;
   int imperfection_seed = 1;
   double cg_tolerance = 1e-8;           // PCG stops when |r| <= cg_tolerance * |b| (filtered)
   bool cg_tolerance_stated = false;     // the scene gave cg_tolerance (else use_motion_tolerance may relax it)

@@ -96,6 +96,8 @@ TEST(Strategy, ClothForcesGrowWindowsBackwardsFromTheLastKeyframe) {
     EXPECT_EQ(s.substeps, 2);
   }
   EXPECT_EQ(budget, 300);
+  EXPECT_EQ(plan.stages.front().max_evaluations, 150);  // the shortest window's gradient is the tame one
+  EXPECT_EQ(plan.stages[1].max_evaluations, 37);
   EXPECT_FALSE(plan.stages.back().controls);  // the last stage optimises the scene's own controls
   EXPECT_TRUE(plan.scaled_first_step);
   EXPECT_NE(plan.why.find("windows from frames 23, 18, 8, 0 to frame 28, each on a 3 x 3 lattice"), std::string::npos)
