@@ -581,6 +581,41 @@ void run_job_stage(const JobContext& c, const std::vector<StageSpec>& stages, si
   record_stage(res, job);
 }
 
+// After a single stage of forces that stalled with evaluations left (StagePlan::windows_on_stall): the
+// windows from no force with what is left, appended to `stages`; the single stage's result is kept when
+// the windows end no lower.
+void windows_after_stall(const JobContext& c, std::vector<StageSpec>& stages, JobResult& job, TimeSpec& z_time) {
+  const StageResult single = job.stages.back();
+  const int left = stages[0].max_evaluations - single.evaluations;
+  if (!c.plan.windows_on_stall || stages.size() != 1 || job.interrupted || c.resuming || c.opt.max_evaluations >= 0 ||
+      single.status.rfind("stopped: line search", 0) != 0 || left < std::max(10, stages[0].max_evaluations / 10))
+    return;
+  const VecX best = job.z;
+  const ClothSystem::StepSchedule best_schedule = job.schedule;
+  std::vector<StageSpec> windows = window_stages(c.scene, left);
+  std::ostringstream os;
+  os << "the one stage stalled at objective " << std::scientific << std::setprecision(3) << single.objective_end
+     << " with " << left << " evaluations left: windows grown back from the last keyframe, from no force";
+  c.elog.say(os.str());
+  StagePlan plan = c.plan;
+  plan.scaled_first_step = true;
+  const JobContext wc{c.scene, c.opt, plan, c.dir, c.resuming, c.max_memory, c.all_evaluations, c.elog};
+  job.problem.reset();
+  job.z = VecX();
+  z_time = c.scene.time;
+  stages.insert(stages.end(), windows.begin(), windows.end());
+  for (size_t s = 1; s < stages.size() && !job.interrupted; ++s) {
+    run_job_stage(wc, stages, s, job, z_time);
+    if (s + 1 < stages.size())
+      stages[s + 1].max_evaluations += std::max(0, stages[s].max_evaluations - job.stages.back().evaluations);
+  }
+  if (job.stages.back().objective_end < single.objective_end) return;
+  c.elog.say("the windows ended no lower: the one stage's result is kept");
+  job.z = best;
+  job.schedule = best_schedule;
+  if (ClothSystem* cloth = cloth_of(*job.sys); cloth && job.hold_splits) cloth->hold_schedule(job.schedule);
+}
+
 // The closing lines: status, objective and the diagnosis (or how to resume), on the log and, when quiet,
 // on standard output.
 void say_outcome(const OptimizeOptions& opt, const fs::path& dir, const JobResult& job, const nlohmann::json& report,
@@ -641,6 +676,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     if (s + 1 < stages.size() && opt.max_evaluations < 0)
       stages[s + 1].max_evaluations += std::max(0, stages[s].max_evaluations - job.stages.back().evaluations);
   }
+  windows_after_stall(context, stages, job, z_time);
 
   nlohmann::json report;
   naming_run_dir(staged, [&] { report = write_run_report(work, scene, stages.size(), resuming, job, elog); });

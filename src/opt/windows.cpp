@@ -19,12 +19,14 @@ int last_keyframe(const Scene& scene) {
   return scene.objectives.empty() ? scene.time.frames : std::min(last, scene.time.frames);
 }
 
+}  // namespace
+
 // Windows grown backwards from the last keyframe. The first (shortest) window gets half the budget, the
 // others share the rest equally: its gradient is the only tame one, so it does most of the work and is still
 // descending at an equal share, while longer windows mostly stall within a few evaluations and pass their
 // unspent budget on. Per-frame forces act on the 3 x 3 lattice in every window, then per particle over the
 // last (the whole) window.
-std::vector<StageSpec> window_stages(const Scene& scene) {
+std::vector<StageSpec> window_stages(const Scene& scene, int budget) {
   const OptimizerSpec& o = scene.optimizer;
   const ControlSpec& c = scene.controls;
   const bool lattice = c.kind == ControlKind::kPerFrame;
@@ -33,12 +35,12 @@ std::vector<StageSpec> window_stages(const Scene& scene) {
   for (long w = o.window_frames; last - w > c.from_frame; w *= 2) starts.push_back(int(last - w));
   starts.push_back(c.from_frame);
   const int windows = int(starts.size()), n = windows + (lattice ? 1 : 0);
-  const int first = n > 1 ? std::max(1, o.max_evaluations / 2) : o.max_evaluations;
-  const int part = n > 1 ? std::max(1, (o.max_evaluations - first) / (n - 1)) : 0;
+  const int first = n > 1 ? std::max(1, budget / 2) : budget;
+  const int part = n > 1 ? std::max(1, (budget - first) / (n - 1)) : 0;
   std::vector<StageSpec> stages;
   for (int k = 0; k < n; ++k) {
-    const int budget = k == 0 ? first : k + 1 < n ? part : std::max(1, o.max_evaluations - first - part * (n - 2));
-    StageSpec s{scene.time.substeps, budget, std::nullopt};
+    const int share = k == 0 ? first : k + 1 < n ? part : std::max(1, budget - first - part * (n - 2));
+    StageSpec s{scene.time.substeps, share, std::nullopt};
     if (k + 1 < n) {
       ControlSpec window = c;
       window.from_frame = starts[k];
@@ -49,6 +51,8 @@ std::vector<StageSpec> window_stages(const Scene& scene) {
   }
   return stages;
 }
+
+namespace {
 
 std::string describe(const std::vector<StageSpec>& stages, int scene_from) {
   std::ostringstream os;
@@ -124,7 +128,7 @@ StagePlan plan_stages(const Scene& scene) {
   // the contact that makes a per-particle gradient rough may begin only later (a towel sliding off its rail).
   const bool contact = c.kind == ControlKind::kPerFrame && (!scene.cloth->colliders.empty() || scene.character);
   if (plan.growth > o.window_growth || contact) {
-    plan.stages = window_stages(scene);
+    plan.stages = window_stages(scene, o.max_evaluations);
     plan.scaled_first_step = true;
     if (plan.growth > o.window_growth) os << " (above optimizer.window_growth " << o.window_growth << ")";
     else os << " (the sheet meets colliders or a body)";
@@ -133,7 +137,9 @@ StagePlan plan_stages(const Scene& scene) {
     if (c.kind == ControlKind::kPerFrame)
       os << ", each on a 3 x 3 lattice of forces over the sheet, then one force per particle from frame " << c.from_frame;
   } else {
-    os << " (not above optimizer.window_growth " << o.window_growth << "): one stage";
+    os << " (not above optimizer.window_growth " << o.window_growth
+       << "): one stage, then windows from no force if it stalls with evaluations left";
+    plan.windows_on_stall = true;
   }
   plan.why = os.str();
   return plan;

@@ -8,7 +8,8 @@
 //    last keyframe), or per-frame forces on a sheet with colliders or a body at all, act first over the
 //    last `window_frames` frames before the last keyframe (with half the evaluations), then over windows
 //    twice, four times ... as long, down to controls.from_frame; each stage starts from the forces
-//    the last one found (new frames without force), so a longer window can only improve on it. Per-frame
+//    the last one found (new frames without force), so a longer window can only improve on it. Below the
+//    threshold, one stage, and the windows if its line search stalls with evaluations left. Per-frame
 //    forces act on a 3 x 3 lattice over the sheet in every window, then per particle over the whole one:
 //    in contact a per-particle gradient is ruled by the few particles touching, and its line search stalls
 //    where a force on the sheet as a whole still moves it (a cape on a swinging body: 8.8 cm per particle,
@@ -32,11 +33,19 @@ struct StagePlan {
   // The strategy staged the run (windows, or a rigid throw first): an automatic optimizer.first_step is
   // then the problem's control_scale(); elsewhere it is off, and a run is as it was without strategies.
   bool scaled_first_step = false;
+  // One stage of forces whose start is tame: when its line search stalls with evaluations left, the run
+  // optimises again in windows from no force with what is left (window_stages) and keeps the better result.
+  // A tame start may roughen later: a wavy sheet wrinkles as it swings (a curtain, a flag).
+  bool windows_on_stall = false;
   std::string why;                // one line: the plan and what chose it
 };
 
 // The stages of `scene`. Measuring the growth costs one simulation and its adjoint pass.
 StagePlan plan_stages(const Scene& scene);
+
+// The windows grown back from the last keyframe for per-step or per-frame forces, sharing `budget`
+// evaluations (the first window half of them).
+std::vector<StageSpec> window_stages(const Scene& scene, int budget);
 
 // Per-frame force controls' gradient at z: the largest frame's gradient norm over the norm of frame
 // `reference`'s (infinite when that is zero and another is not; 1 when all are zero).

@@ -114,6 +114,15 @@ TEST(Strategy, ClothForcesGrowWindowsBackwardsFromTheLastKeyframe) {
   EXPECT_EQ(one.stages.size(), 1u);
   EXPECT_EQ(one.growth, plan.growth);
   EXPECT_FALSE(one.scaled_first_step);  // a run the strategy leaves alone runs as it did without it
+  EXPECT_TRUE(one.windows_on_stall);     // ... unless its one stage stalls with evaluations left
+  EXPECT_FALSE(plan.windows_on_stall);
+  // What a stalled stage leaves: the same windows sharing it, the first half.
+  const std::vector<StageSpec> after = window_stages(tame, 101);
+  EXPECT_EQ(window_starts(after, 0), (std::vector<int>{23, 18, 8, 0, 0}));
+  int left = 0;
+  for (const auto& s : after) left += s.max_evaluations;
+  EXPECT_EQ(left, 101);
+  EXPECT_EQ(after.front().max_evaluations, 50);
 }
 
 // The growth is read from the gradient's frames: a keyframe's own frame's forces against earlier ones.
