@@ -14,6 +14,10 @@ Vec3 layout_position(const ClothSpec& c, int particle) {
   return c.origin + (particle % c.nx) * dx * c.u_axis + (particle / c.nx) * dy * c.v_axis;
 }
 
+// A pinned particle's own target this close to it (metres) is where the pin holds it: targets are written
+// rounded (shapes.json's to 0.1 mm).
+constexpr double kPinnedTargetSlack = 1e-3;
+
 // The pin that most limits a particle at rest position `rest` from reaching `target`: the largest ratio of
 // the target's distance from the pin to the particle's rest distance from it (-1 when no pin limits it).
 struct Limit {
@@ -25,7 +29,7 @@ Limit worst_pin(const ClothSpec& c, const Vec3& rest, const Vec3& target) {
   for (int p : c.pins) {
     const Vec3 pin = layout_position(c, p);
     const double reach = (rest - pin).norm(), distance = (target - pin).norm();
-    const double ratio = reach > 0 ? distance / reach : (distance > 1e-9 ? 1e30 : 0.0);
+    const double ratio = reach > 0 ? distance / reach : (distance > kPinnedTargetSlack ? 1e30 : 0.0);
     if (ratio > w.ratio) w = {ratio, distance, reach, p};
   }
   return w;

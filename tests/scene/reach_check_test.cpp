@@ -39,6 +39,11 @@ TEST(ReachCheck, ReachableTargetsAndUnpinnedSheetsAreQuiet) {
   // Swinging the sheet sideways keeps every particle within its rest distance of both pins.
   EXPECT_TRUE(unreachable_keyframes(parse_scene(hanging_sheet(R"({"type": "center_of_mass", "frame": 10, "target": [0.5, 0.6, 0.4]},
       {"type": "position", "frame": 5, "particles": [0], "targets": [[0, 0.1, 0.4]]})"), "near.json")).empty());
+  // A pinned particle's own target written rounded (0.1 mm off) is where its pin holds it; 10 cm off is not.
+  EXPECT_TRUE(unreachable_keyframes(parse_scene(hanging_sheet(R"({"type": "position", "frame": 5, "particles": [20],
+      "targets": [[0.0001, 1, 0]]})"), "pinned.json")).empty());
+  EXPECT_EQ(unreachable_keyframes(parse_scene(hanging_sheet(R"({"type": "position", "frame": 5, "particles": [20],
+      "targets": [[0, 1.1, 0]]})"), "pinned.json")).size(), 1u);
   std::string free = hanging_sheet(R"({"type": "center_of_mass", "frame": 10, "target": [0.5, -30, 0]})");
   free.replace(free.find("\"top_corners\""), 13, "\"none\"");
   EXPECT_TRUE(unreachable_keyframes(parse_scene(free, "free.json")).empty());

@@ -51,7 +51,8 @@ VecX rest_positions(const ClothSpec& spec) {
   VecX x0(3 * spec.particles());
   for (int j = 0; j < spec.ny; ++j)
     for (int i = 0; i < spec.nx; ++i) seg(x0, spec.index(i, j)) = spec.origin + i * dx * spec.u_axis + j * dy * spec.v_axis;
-  add_imperfection(x0, spec.u_axis.cross(spec.v_axis), spec.imperfection, uint64_t(spec.imperfection_seed));
+  add_imperfection(x0, spec.u_axis.cross(spec.v_axis), spec.imperfection, uint64_t(spec.imperfection_seed),
+                   spec.pins);
   return x0;
 }
 
