@@ -581,20 +581,21 @@ void run_job_stage(const JobContext& c, const std::vector<StageSpec>& stages, si
   record_stage(res, job);
 }
 
-// After a single stage of forces that stalled with evaluations left (StagePlan::windows_on_stall): the
-// windows from no force with what is left, appended to `stages`; the single stage's result is kept when
-// the windows end no lower.
-void windows_after_stall(const JobContext& c, std::vector<StageSpec>& stages, JobResult& job, TimeSpec& z_time) {
+// After a single stage of forces that ended early, stalled or converged, with evaluations left
+// (StagePlan::windows_on_early_end): the windows from no force with what is left, appended to `stages`; the
+// single stage's result is kept when the windows end no lower.
+void windows_after_early_end(const JobContext& c, std::vector<StageSpec>& stages, JobResult& job, TimeSpec& z_time) {
   const StageResult single = job.stages.back();
   const int left = stages[0].max_evaluations - single.evaluations;
-  if (!c.plan.windows_on_stall || stages.size() != 1 || job.interrupted || c.resuming || c.opt.max_evaluations >= 0 ||
-      single.status.rfind("stopped: line search", 0) != 0 || left < std::max(10, stages[0].max_evaluations / 10))
+  if (!c.plan.windows_on_early_end || stages.size() != 1 || job.interrupted || c.resuming || c.opt.max_evaluations >= 0 ||
+      (single.status.rfind("converged", 0) != 0 && single.status.rfind("stopped: line search", 0) != 0) ||
+      left < std::max(10, stages[0].max_evaluations / 10))
     return;
   const VecX best = job.z;
   const ClothSystem::StepSchedule best_schedule = job.schedule;
   std::vector<StageSpec> windows = window_stages(c.scene, left);
   std::ostringstream os;
-  os << "the one stage stalled at objective " << std::scientific << std::setprecision(3) << single.objective_end
+  os << "the one stage ended (" << single.status << ") at objective " << std::scientific << std::setprecision(3) << single.objective_end
      << " with " << left << " evaluations left: windows grown back from the last keyframe, from no force";
   c.elog.say(os.str());
   StagePlan plan = c.plan;
@@ -676,7 +677,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     if (s + 1 < stages.size() && opt.max_evaluations < 0)
       stages[s + 1].max_evaluations += std::max(0, stages[s].max_evaluations - job.stages.back().evaluations);
   }
-  windows_after_stall(context, stages, job, z_time);
+  windows_after_early_end(context, stages, job, z_time);
 
   nlohmann::json report;
   naming_run_dir(staged, [&] { report = write_run_report(work, scene, stages.size(), resuming, job, elog); });

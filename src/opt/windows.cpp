@@ -138,8 +138,8 @@ StagePlan plan_stages(const Scene& scene) {
       os << ", each on a 3 x 3 lattice of forces over the sheet, then one force per particle from frame " << c.from_frame;
   } else {
     os << " (not above optimizer.window_growth " << o.window_growth
-       << "): one stage, then windows from no force if it stalls with evaluations left";
-    plan.windows_on_stall = true;
+       << "): one stage, then windows from no force if it ends early with evaluations left";
+    plan.windows_on_early_end = true;
   }
   plan.why = os.str();
   return plan;

@@ -9,7 +9,7 @@
 //    last `window_frames` frames before the last keyframe (with half the evaluations), then over windows
 //    twice, four times ... as long, down to controls.from_frame; each stage starts from the forces
 //    the last one found (new frames without force), so a longer window can only improve on it. Below the
-//    threshold, one stage, and the windows if its line search stalls with evaluations left. Per-frame
+//    threshold, one stage, and the windows if it ends early with evaluations left. Per-frame
 //    forces act on a 3 x 3 lattice over the sheet in every window, then per particle over the whole one:
 //    in contact a per-particle gradient is ruled by the few particles touching, and its line search stalls
 //    where a force on the sheet as a whole still moves it (a cape on a swinging body: 8.8 cm per particle,
@@ -33,10 +33,12 @@ struct StagePlan {
   // The strategy staged the run (windows, or a rigid throw first): an automatic optimizer.first_step is
   // then the problem's control_scale(); elsewhere it is off, and a run is as it was without strategies.
   bool scaled_first_step = false;
-  // One stage of forces whose start is tame: when its line search stalls with evaluations left, the run
-  // optimises again in windows from no force with what is left (window_stages) and keeps the better result.
-  // A tame start may roughen later: a wavy sheet wrinkles as it swings (a curtain, a flag).
-  bool windows_on_stall = false;
+  // One stage of forces whose start is tame: when it ends early (its line search stalls, or it converges)
+  // with evaluations left, the run optimises again in windows from no force with what is left
+  // (window_stages) and keeps the better result. A tame start may roughen later, and one stage over the
+  // whole horizon may settle on forces far costlier than windows find (a flag released in its plane: 5e-2
+  // against 1e-6).
+  bool windows_on_early_end = false;
   std::string why;                // one line: the plan and what chose it
 };
 

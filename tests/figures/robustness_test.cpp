@@ -65,16 +65,16 @@ TEST(Robustness, TowelDroppedBesideItsRailHangsCentredOnItThroughLatticeWindows)
 
 // The flag released in its vertical plane (the suite's scene as it is): with the default waviness its start
 // is tame (the force gradient grows a few hundredfold, below optimizer.window_growth), so it runs as one
-// stage, whose line search stalls 31 cm away as the flag wrinkles; the windows from no force that follow,
-// with the evaluations left, reach the keyframe.
-TEST(Robustness, FlagWhoseOneStageStallsReachesItsKeyframeThroughWindows) {
+// stage, which ends early (seed 1 converges on forces costing 5e-2; seeds 2-5 stall at 7e-3 to 3e-2); the
+// windows from no force that follow, with the evaluations left, end a hundred times lower.
+TEST(Robustness, FlagWhoseOneStageEndsEarlyGoesOnInWindows) {
   test::TempDir dir;
   const json report = optimise(suite_scene("flag-released"), dir.path());
   expect_every_keyframe_met(report);
   const json& stages = report.at("stage_results");
   ASSERT_GE(stages.size(), 3u) << stages.dump();
   EXPECT_EQ(stages[0].at("kind"), "per_frame");
-  EXPECT_EQ(stages[0].at("status").get<std::string>().rfind("stopped: line search", 0), 0u) << stages.dump();
+  EXPECT_NE(stages[0].at("status").get<std::string>().rfind("evaluation limit", 0), 0u) << stages.dump();
   EXPECT_EQ(stages[1].at("kind"), "per_frame_lattice");
   EXPECT_EQ(stages.back().at("kind"), "per_frame");
   EXPECT_LT(stages.back().at("objective_end").get<double>(), 0.01 * stages[0].at("objective_end").get<double>());

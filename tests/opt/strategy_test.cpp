@@ -114,8 +114,8 @@ TEST(Strategy, ClothForcesGrowWindowsBackwardsFromTheLastKeyframe) {
   EXPECT_EQ(one.stages.size(), 1u);
   EXPECT_EQ(one.growth, plan.growth);
   EXPECT_FALSE(one.scaled_first_step);  // a run the strategy leaves alone runs as it did without it
-  EXPECT_TRUE(one.windows_on_stall);     // ... unless its one stage stalls with evaluations left
-  EXPECT_FALSE(plan.windows_on_stall);
+  EXPECT_TRUE(one.windows_on_early_end);     // ... unless its one stage stalls with evaluations left
+  EXPECT_FALSE(plan.windows_on_early_end);
   // What a stalled stage leaves: the same windows sharing it, the first half.
   const std::vector<StageSpec> after = window_stages(tame, 101);
   EXPECT_EQ(window_starts(after, 0), (std::vector<int>{23, 18, 8, 0, 0}));
