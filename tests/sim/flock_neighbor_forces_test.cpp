@@ -19,50 +19,53 @@ TEST(NeighborForces, EqualsTheSeparateTermsForwardAndTransposed) {
   const int p = 60;
   std::mt19937_64 rng(9);
   const VecX x = random_planar(p, 4.0, rng), v = random_planar(p, 1.0, rng), y = random_planar(p, 1.0, rng);
-  FlockSpec spec;
-  spec.agents = p;
-  spec.avoidance = {6.0, 1.5};
-  spec.matching = {0.5, 2.5};
-  spec.centering = {1.0, 3.5};  // every radius different
-  NeighborForces fused(spec);
-  ASSERT_EQ(fused.radius(), 3.5);
-  NeighborGrid grid;
-  grid.build(x, fused.radius());
-  AvoidanceForce avoid({6.0, 1.5});
-  MatchingForce match({0.5, 2.5});
-  CenteringForce centre({1.0, 3.5});
-  const FlockState s{0, x, v, grid.lists()};
-  centre.prepare(s);
-  std::vector<AgentMotion> motion(p);
-  pack_motion(x, v, motion);
-  std::vector<Planar> offset(p);
-  std::vector<double> b(p);
-  double largest = 0;
-  for (int i = 0; i < p; ++i) {
-    Vec3 f_ref = Vec3::Zero();
-    const Planar fp = fused.force(motion.data(), grid.neighbors(i), i, offset[i], b[i]);
-    const Vec3 f(fp.x, 0, fp.z);
-    avoid.add_force(s, i, f_ref);
-    match.add_force(s, i, f_ref);
-    centre.add_force(s, i, f_ref);
-    largest = std::max(largest, f_ref.norm());
-    EXPECT_LT((f - f_ref).norm(), 1e-12 * (1 + f_ref.norm())) << "agent " << i;
-  }
-  ASSERT_GT(largest, 0.1);
-  std::vector<AgentAdjoint> adjoint(p);
-  for (int i = 0; i < p; ++i)
-    adjoint[i] = {x[3 * i], x[3 * i + 2], v[3 * i], v[3 * i + 2], y[3 * i], y[3 * i + 2], offset[i].x, offset[i].z, 1.0 / b[i]};
-  for (int j = 0; j < p; ++j) {
-    Vec3 kt_ref = Vec3::Zero(), dt_ref = Vec3::Zero();
-    Planar kp, dp;
-    fused.transpose_apply(adjoint.data(), grid.neighbors(j), j, kp, dp);
-    const Vec3 kt(kp.x, 0, kp.z), dt(dp.x, 0, dp.z);
-    avoid.add_KT(s, y, j, kt_ref);
-    match.add_KT(s, y, j, kt_ref);
-    centre.add_KT(s, y, j, kt_ref);
-    match.add_DT(s, y, j, dt_ref);
-    EXPECT_LT((kt - kt_ref).norm(), 1e-11 * (1 + kt_ref.norm())) << "agent " << j;
-    EXPECT_LT((dt - dt_ref).norm(), 1e-11 * (1 + dt_ref.norm())) << "agent " << j;
+  // Every radius different, then matching and centering sharing one (their kernel weight computed once).
+  for (const double rc : {3.5, 2.5}) {
+    FlockSpec spec;
+    spec.agents = p;
+    spec.avoidance = {6.0, 1.5};
+    spec.matching = {0.5, 2.5};
+    spec.centering = {1.0, rc};
+    NeighborForces fused(spec);
+    ASSERT_EQ(fused.radius(), rc);
+    NeighborGrid grid;
+    grid.build(x, fused.radius());
+    AvoidanceForce avoid({6.0, 1.5});
+    MatchingForce match({0.5, 2.5});
+    CenteringForce centre({1.0, rc});
+    const FlockState s{0, x, v, grid.lists()};
+    centre.prepare(s);
+    std::vector<AgentMotion> motion(p);
+    pack_motion(x, v, motion);
+    std::vector<Planar> offset(p);
+    std::vector<double> b(p);
+    double largest = 0;
+    for (int i = 0; i < p; ++i) {
+      Vec3 f_ref = Vec3::Zero();
+      const Planar fp = fused.force(motion.data(), grid.neighbors(i), i, offset[i], b[i]);
+      const Vec3 f(fp.x, 0, fp.z);
+      avoid.add_force(s, i, f_ref);
+      match.add_force(s, i, f_ref);
+      centre.add_force(s, i, f_ref);
+      largest = std::max(largest, f_ref.norm());
+      EXPECT_LT((f - f_ref).norm(), 1e-12 * (1 + f_ref.norm())) << "agent " << i;
+    }
+    ASSERT_GT(largest, 0.1);
+    std::vector<AgentAdjoint> adjoint(p);
+    for (int i = 0; i < p; ++i)
+      adjoint[i] = {x[3 * i], x[3 * i + 2], v[3 * i], v[3 * i + 2], y[3 * i], y[3 * i + 2], offset[i].x, offset[i].z, 1.0 / b[i]};
+    for (int j = 0; j < p; ++j) {
+      Vec3 kt_ref = Vec3::Zero(), dt_ref = Vec3::Zero();
+      Planar kp, dp;
+      fused.transpose_apply(adjoint.data(), grid.neighbors(j), j, kp, dp);
+      const Vec3 kt(kp.x, 0, kp.z), dt(dp.x, 0, dp.z);
+      avoid.add_KT(s, y, j, kt_ref);
+      match.add_KT(s, y, j, kt_ref);
+      centre.add_KT(s, y, j, kt_ref);
+      match.add_DT(s, y, j, dt_ref);
+      EXPECT_LT((kt - kt_ref).norm(), 1e-11 * (1 + kt_ref.norm())) << "agent " << j;
+      EXPECT_LT((dt - dt_ref).norm(), 1e-11 * (1 + dt_ref.norm())) << "agent " << j;
+    }
   }
 }
 

@@ -25,7 +25,8 @@ NeighborForces::NeighborForces(const FlockSpec& s)
       inv_ra2_(1.0 / (s.avoidance.radius * s.avoidance.radius)),
       inv_rm2_(1.0 / (s.matching.radius * s.matching.radius)),
       inv_rc2_(1.0 / (s.centering.radius * s.centering.radius)),
-      eps2_(AvoidancePair::kSoftening * AvoidancePair::kSoftening * (s.avoidance.radius * s.avoidance.radius)) {
+      eps2_(AvoidancePair::kSoftening * AvoidancePair::kSoftening * (s.avoidance.radius * s.avoidance.radius)),
+      same_mc_(rm2_ > 0 && rm2_ == rc2_ && inv_rm2_ == inv_rc2_) {
   if (ka_ > 0) radius_ = std::max(radius_, s.avoidance.radius);
   if (kmatch_ > 0) radius_ = std::max(radius_, s.matching.radius);
   if (kc_ > 0) radius_ = std::max(radius_, s.centering.radius);
@@ -42,13 +43,14 @@ inline PairForward NeighborForces::forward_pair(const AgentMotion& ai, const Age
     q.ax = wg * dx;
     q.az = wg * dz;
   }
+  double wm = 0;
   if (r2 < rm2_) {  // matching: w (v_j - v_i)
-    const double w = smooth_kernel_inv(r2, inv_rm2_).w;
-    q.mx = w * (aj.vx - ai.vx);
-    q.mz = w * (aj.vz - ai.vz);
+    wm = smooth_kernel_inv(r2, inv_rm2_).w;
+    q.mx = wm * (aj.vx - ai.vx);
+    q.mz = wm * (aj.vz - ai.vz);
   }
   if (r2 < rc2_) {  // centering sums: a -= w d, b += w
-    const double w = smooth_kernel_inv(r2, inv_rc2_).w;
+    const double w = same_mc_ ? wm : smooth_kernel_inv(r2, inv_rc2_).w;
     q.cx = w * dx;
     q.cz = w * dz;
     q.w = w;
@@ -70,9 +72,10 @@ inline PairTransposed NeighborForces::transposed_pair(const AgentAdjoint& aj, co
     q.kax = wg * ex + s * dx;
     q.kaz = wg * ez + s * dz;
   }
+  KernelWeight km;
   if (r2 < rm2_) {
     // K^T: 2 w' ((v_i - v_j) . (y_j - y_i)) d;  D^T: w (y_i - y_j).
-    const KernelWeight k = smooth_kernel_inv(r2, inv_rm2_);
+    const KernelWeight k = km = smooth_kernel_inv(r2, inv_rm2_);
     const double s = 2.0 * k.dw_dr2 * ((ai.vx - aj.vx) * (aj.yx - ai.yx) + (ai.vz - aj.vz) * (aj.yz - ai.yz));
     q.kmx = s * dx;
     q.kmz = s * dz;
@@ -81,7 +84,7 @@ inline PairTransposed NeighborForces::transposed_pair(const AgentAdjoint& aj, co
   }
   if (r2 < rc2_) {
     // (d f_i/d x_j)^T y_i - (d f_j/d x_i)^T y_j with g_i = -2 w' d (CenteringPair::add_KT).
-    const KernelWeight k = smooth_kernel_inv(r2, inv_rc2_);
+    const KernelWeight k = same_mc_ ? km : smooth_kernel_inv(r2, inv_rc2_);
     const double gx = -2.0 * k.dw_dr2 * dx, gz = -2.0 * k.dw_dr2 * dz;
     const double si = (ai.ox - dx) * ai.yx + (ai.oz - dz) * ai.yz;
     const double sj = (dx + aj.ox) * aj.yx + (dz + aj.oz) * aj.yz;

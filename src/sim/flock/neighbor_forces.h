@@ -94,6 +94,8 @@ class NeighborForces {
   double ra2_, rm2_, rc2_;            // squared radii, 0 for a term that is off
   double inv_ra2_, inv_rm2_, inv_rc2_;  // 1/R^2 of each term
   double eps2_;                       // avoidance softening^2 (m^2)
+  // Matching and centering both on with one radius: a pair's kernel weight serves both (the same value).
+  bool same_mc_;
   double radius_ = 0;
 };
 
