@@ -65,7 +65,7 @@ void FlockSystem::search(FlockRecord& r, const VecX& x, const VecX& v, bool with
     pack_motion(x, v, motion_);
     compute_forward_pairs(r);
     parallel_agents(p, [&](int i) {
-      neighbor_forces_.gather_force(r.lists, pair_index_, forward_pairs_.data(), i, r.offset[i], r.b[i]);
+      neighbor_forces_.gather_force(r.lists, pair_index_, forward_pairs_, i, r.offset[i], r.b[i]);
     });
   }
 }
@@ -73,15 +73,16 @@ void FlockSystem::search(FlockRecord& r, const VecX& x, const VecX& v, bool with
 void FlockSystem::compute_forward_pairs(const FlockRecord& r) {
   if (!neighbor_forces_.any()) return;
   pair_index_.build(r.lists);
-  if (forward_pairs_.size() < std::size_t(pair_index_.pairs())) forward_pairs_.resize(pair_index_.pairs());
+  forward_pairs_ = pair_buffer_.as<PairForward>(pair_index_.pairs());
+  transposed_pairs_ = nullptr;
   parallel_agents(spec_.agents, [&](int i) {
-    neighbor_forces_.forward_pairs(motion_.data(), r.lists, pair_index_, i, forward_pairs_.data());
+    neighbor_forces_.forward_pairs(motion_.data(), r.lists, pair_index_, i, forward_pairs_);
   });
 }
 
 void FlockSystem::add_neighbor_force(FlockRecord& r, int i, Vec3& f) const {
   if (!neighbor_forces_.any()) return;
-  const Planar fn = neighbor_forces_.gather_force(r.lists, pair_index_, forward_pairs_.data(), i, r.offset[i], r.b[i]);
+  const Planar fn = neighbor_forces_.gather_force(r.lists, pair_index_, forward_pairs_, i, r.offset[i], r.b[i]);
   f.x() += fn.x;
   f.z() += fn.z;
 }
@@ -94,9 +95,10 @@ void FlockSystem::pack_adjoint(const FlockRecord& r, const VecX& y) {
   });
   if (!neighbor_forces_.any()) return;
   pair_index_.build(r.lists);
-  if (transposed_pairs_.size() < std::size_t(pair_index_.pairs())) transposed_pairs_.resize(pair_index_.pairs());
+  transposed_pairs_ = pair_buffer_.as<PairTransposed>(pair_index_.pairs());
+  forward_pairs_ = nullptr;
   parallel_agents(spec_.agents, [&](int j) {
-    neighbor_forces_.transposed_pairs(adjoint_.data(), r.lists, pair_index_, j, transposed_pairs_.data());
+    neighbor_forces_.transposed_pairs(adjoint_.data(), r.lists, pair_index_, j, transposed_pairs_);
   });
 }
 
@@ -137,7 +139,7 @@ void FlockSystem::transpose_apply(const FlockRecord& r, int n, const VecX& x, co
   dt.setZero();
   if (neighbor_forces_.any()) {
     Planar k, d;
-    neighbor_forces_.gather_transposed(r.lists, pair_index_, transposed_pairs_.data(), j, k, d);
+    neighbor_forces_.gather_transposed(r.lists, pair_index_, transposed_pairs_, j, k, d);
     kt = Vec3(k.x, 0, k.z);
     dt = Vec3(d.x, 0, d.z);
   }

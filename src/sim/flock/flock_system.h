@@ -17,6 +17,7 @@
 #include "sim/flock/flock_force.h"
 #include "sim/flock/neighbor_forces.h"
 #include "sim/flock/neighbor_grid.h"
+#include "sim/flock/pair_buffer.h"
 #include "sim/flock/pair_index.h"
 #include "sim/system.h"
 
@@ -89,8 +90,11 @@ class FlockSystem final : public System {
   std::vector<AgentMotion> motion_;    // the state being stepped, packed (p)
   std::vector<AgentAdjoint> adjoint_;  // the same with y and the centering quantities (p)
   PairIndex pair_index_;                // of the lists being evaluated
-  std::vector<PairForward> forward_pairs_;        // per pair (pair_index_)
-  std::vector<PairTransposed> transposed_pairs_;  // per pair
+  // Per pair (pair_index_), in one buffer: the forward terms of the state last packed, or its transposed ones
+  // (whichever was computed last; the other pointer is null).
+  PairBuffer pair_buffer_;
+  PairForward* forward_pairs_ = nullptr;
+  PairTransposed* transposed_pairs_ = nullptr;
   int spawn_entries_ = 0;  // neighbour entries at the initial state
   int most_entries_ = 0;   // the most any step has found
   FlockRecord scratch_;  // forces() and apply_KT_DT
