@@ -581,22 +581,34 @@ void run_job_stage(const JobContext& c, const std::vector<StageSpec>& stages, si
   record_stage(res, job);
 }
 
+// Runs stages[first], stages[first + 1], ...: a stage that converged or stalled early leaves its unspent
+// evaluations to the next (unless --max-evaluations sets every stage's).
+void run_stages(const JobContext& c, std::vector<StageSpec>& stages, size_t first, JobResult& job, TimeSpec& z_time) {
+  for (size_t s = first; s < stages.size() && !job.interrupted; ++s) {
+    run_job_stage(c, stages, s, job, z_time);
+    if (s + 1 < stages.size() && c.opt.max_evaluations < 0)
+      stages[s + 1].max_evaluations += std::max(0, stages[s].max_evaluations - job.stages.back().evaluations);
+  }
+}
+
 // After a single stage of forces that ended early, stalled or converged, with evaluations left
 // (StagePlan::windows_on_early_end): the windows from no force with what is left, appended to `stages`; the
 // single stage's result is kept when the windows end no lower.
 void windows_after_early_end(const JobContext& c, std::vector<StageSpec>& stages, JobResult& job, TimeSpec& z_time) {
   const StageResult single = job.stages.back();
   const int left = stages[0].max_evaluations - single.evaluations;
-  if (!c.plan.windows_on_early_end || stages.size() != 1 || job.interrupted || c.resuming || c.opt.max_evaluations >= 0 ||
-      (single.status.rfind("converged", 0) != 0 && single.status.rfind("stopped: line search", 0) != 0) ||
-      left < std::max(10, stages[0].max_evaluations / 10))
+  const bool ended_early =
+      single.status.rfind("converged", 0) == 0 || single.status.rfind("stopped: line search", 0) == 0;
+  if (!c.plan.windows_on_early_end || stages.size() != 1 || job.interrupted || c.resuming ||
+      c.opt.max_evaluations >= 0 || !ended_early || left < std::max(10, stages[0].max_evaluations / 10))
     return;
   const VecX best = job.z;
   const ClothSystem::StepSchedule best_schedule = job.schedule;
   std::vector<StageSpec> windows = window_stages(c.scene, left);
   std::ostringstream os;
-  os << "the one stage ended (" << single.status << ") at objective " << std::scientific << std::setprecision(3) << single.objective_end
-     << " with " << left << " evaluations left: windows grown back from the last keyframe, from no force";
+  os << "the one stage ended (" << single.status << ") at objective " << std::scientific << std::setprecision(3)
+     << single.objective_end << " with " << left
+     << " evaluations left: windows grown back from the last keyframe, from no force";
   c.elog.say(os.str());
   StagePlan plan = c.plan;
   plan.scaled_first_step = true;
@@ -605,11 +617,7 @@ void windows_after_early_end(const JobContext& c, std::vector<StageSpec>& stages
   job.z = VecX();
   z_time = c.scene.time;
   stages.insert(stages.end(), windows.begin(), windows.end());
-  for (size_t s = 1; s < stages.size() && !job.interrupted; ++s) {
-    run_job_stage(wc, stages, s, job, z_time);
-    if (s + 1 < stages.size())
-      stages[s + 1].max_evaluations += std::max(0, stages[s].max_evaluations - job.stages.back().evaluations);
-  }
+  run_stages(wc, stages, 1, job, z_time);
   if (job.stages.back().objective_end < single.objective_end) return;
   c.elog.say("the windows ended no lower: the one stage's result is kept");
   job.z = best;
@@ -671,12 +679,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (!plan.why.empty() && !resuming) elog.say(plan.why);
   SignalGuard signals;
   const JobContext context{scene, opt, plan, dir, resuming, max_memory, all_evaluations, elog};
-  for (size_t s = 0; s < stages.size() && !job.interrupted; ++s) {
-    run_job_stage(context, stages, s, job, z_time);
-    // A stage that converged or stalled early leaves its unspent evaluations to the next.
-    if (s + 1 < stages.size() && opt.max_evaluations < 0)
-      stages[s + 1].max_evaluations += std::max(0, stages[s].max_evaluations - job.stages.back().evaluations);
-  }
+  run_stages(context, stages, 0, job, z_time);
   windows_after_early_end(context, stages, job, z_time);
 
   nlohmann::json report;

@@ -1,9 +1,9 @@
 #pragma once
 // A seeded sub-millimetre imperfection of the initial sheet: every free particle moved off the sheet's plane
-// by an amount drawn uniformly from [-amplitude, amplitude]; pinned ones stay where the scene puts them. The springs take their rest lengths from the
-// moved sheet, so the imperfection is the sheet's own stress-free shape, not a force: a flat, symmetric
-// start then no longer sits on a bifurcation (in-plane compression buckling, a sheet balanced on a
-// sphere) whose side round-off picks.
+// by an amount drawn uniformly from [-amplitude, amplitude]; pinned ones stay where the scene puts them. The
+// springs take their rest lengths from the moved sheet, so the imperfection is the sheet's own stress-free
+// shape, not a force: a flat, symmetric start then no longer sits on a bifurcation (in-plane compression
+// buckling, a sheet balanced on a sphere) whose side round-off picks.
 #include <cstdint>
 #include <vector>
 
