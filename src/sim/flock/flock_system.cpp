@@ -24,17 +24,10 @@ FlockSystem::FlockSystem(const FlockSpec& spec, double h, int steps, unsigned se
   y_.resize(dof());
   motion_.resize(spec.agents);
   adjoint_.resize(spec.agents);
-  if (neighbor_forces_.any()) {
-    NeighborLists spawn;
-    grid_.search_owned(spawn_positions(spec_, seed_), neighbor_forces_.radius(), spawn);
-    spawn_entries_ = spawn.entries();
-  }
 }
 
 std::size_t FlockSystem::record_bytes_estimate() const {
-  const std::size_t p = std::size_t(spec_.agents);
-  const std::size_t entries = std::max(2 * std::size_t(spawn_entries_), std::size_t(most_entries_) * 5 / 4);
-  return sizeof(int) * (2 * p + 1 + entries) + 3 * sizeof(double) * p;
+  return (sizeof(Planar) + sizeof(double)) * std::size_t(spec_.agents);
 }
 
 void FlockSystem::initial_state(VecX& x, VecX& v) const {
@@ -59,30 +52,18 @@ void FlockSystem::search(FlockRecord& r, const VecX& x, const VecX& v, bool with
     std::fill(r.b.begin(), r.b.end(), 1.0);
     return;
   }
-  grid_.search_owned(x, neighbor_forces_.radius(), r.lists);
-  most_entries_ = std::max(most_entries_, r.lists.entries());
+  grid_.search(x, neighbor_forces_.radius(), lists_);
   if (with_centering) {
     pack_motion(x, v, motion_);
-    compute_forward_pairs(r);
     parallel_agents(p, [&](int i) {
-      neighbor_forces_.gather_force(r.lists, pair_index_, forward_pairs_, i, r.offset[i], r.b[i]);
+      neighbor_forces_.force(motion_.data(), lists_.neighbors(i), i, r.offset[i], r.b[i]);
     });
   }
 }
 
-void FlockSystem::compute_forward_pairs(const FlockRecord& r) {
-  if (!neighbor_forces_.any()) return;
-  pair_index_.build(r.lists);
-  forward_pairs_ = pair_buffer_.as<PairForward>(pair_index_.pairs());
-  transposed_pairs_ = nullptr;
-  parallel_agents(spec_.agents, [&](int i) {
-    neighbor_forces_.forward_pairs(motion_.data(), r.lists, pair_index_, i, forward_pairs_);
-  });
-}
-
 void FlockSystem::add_neighbor_force(FlockRecord& r, int i, Vec3& f) const {
   if (!neighbor_forces_.any()) return;
-  const Planar fn = neighbor_forces_.gather_force(r.lists, pair_index_, forward_pairs_, i, r.offset[i], r.b[i]);
+  const Planar fn = neighbor_forces_.force(motion_.data(), lists_.neighbors(i), i, r.offset[i], r.b[i]);
   f.x() += fn.x;
   f.z() += fn.z;
 }
@@ -92,13 +73,6 @@ void FlockSystem::pack_adjoint(const FlockRecord& r, const VecX& y) {
   parallel_agents(spec_.agents, [&](int i) {
     const AgentMotion& m = motion_[i];
     adjoint_[i] = {m.x, m.z, m.vx, m.vz, y[3 * i], y[3 * i + 2], r.offset[i].x, r.offset[i].z, c / r.b[i]};
-  });
-  if (!neighbor_forces_.any()) return;
-  pair_index_.build(r.lists);
-  transposed_pairs_ = pair_buffer_.as<PairTransposed>(pair_index_.pairs());
-  forward_pairs_ = nullptr;
-  parallel_agents(spec_.agents, [&](int j) {
-    neighbor_forces_.transposed_pairs(adjoint_.data(), r.lists, pair_index_, j, transposed_pairs_);
   });
 }
 
@@ -117,7 +91,6 @@ bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
   FlockRecord& r = static_cast<FlockRecord&>(record);
   search(r, x, v, false);  // the step fills the centering quantities itself
   pack_motion(x, v, motion_);
-  compute_forward_pairs(r);
   x_next.resize(dof());
   v_next.resize(dof());
   parallel_agents(spec_.agents, [&](int i) {
@@ -133,18 +106,18 @@ bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
   return x_next.allFinite() && v_next.allFinite();
 }
 
-void FlockSystem::transpose_apply(const FlockRecord& r, int n, const VecX& x, const VecX& v, const VecX& y, int j,
+void FlockSystem::transpose_apply(int n, const VecX& x, const VecX& v, const VecX& y, int j,
                                   Vec3& kt, Vec3& dt) const {
   kt.setZero();
   dt.setZero();
   if (neighbor_forces_.any()) {
     Planar k, d;
-    neighbor_forces_.gather_transposed(r.lists, pair_index_, transposed_pairs_, j, k, d);
+    neighbor_forces_.transpose_apply(adjoint_.data(), lists_.neighbors(j), j, k, d);
     kt = Vec3(k.x, 0, k.z);
     dt = Vec3(d.x, 0, d.z);
   }
   // Local forces only through their interface, so a new one cannot drop out of the adjoint.
-  const FlockState s{n, x, v, r.lists};
+  const FlockState s{n, x, v, lists_};
   for (const auto& force : local_forces_) {
     force->add_KT(s, y, j, kt);
     force->add_DT(s, y, j, dt);
@@ -162,6 +135,7 @@ void FlockSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX&,
     si.y() = 0;
     seg(y_, i) = si / masses_[i];
   });
+  if (neighbor_forces_.any()) grid_.search(x, neighbor_forces_.radius(), lists_);  // the step's own lists
   pack_motion(x, v, motion_);
   pack_adjoint(r, y_);
   xhat.resize(dof());
@@ -169,7 +143,7 @@ void FlockSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX&,
   uhat.resize(dof());
   parallel_agents(p, [&](int j) {
     Vec3 kt, dt;
-    transpose_apply(r, n, x, v, y_, j, kt, dt);
+    transpose_apply(n, x, v, y_, j, kt, dt);
     const Vec3 yj = seg(y_, j);
     Vec3 xh = seg(xhat1, j) + h_ * kt;
     Vec3 vh = seg(vhat1, j) + h_ * seg(xhat1, j) + h_ * dt;  // s_j + h (D^T M^-1 s)_j
@@ -185,7 +159,6 @@ void FlockSystem::forces(int n, const VecX& x, const VecX& v, VecX& f) {
   check_size(x, v);
   search(scratch_, x, v, false);
   pack_motion(x, v, motion_);
-  compute_forward_pairs(scratch_);
   f.resize(dof());
   parallel_agents(spec_.agents, [&](int i) {
     Vec3 fi = local_force(n, v, i);
@@ -202,7 +175,7 @@ void FlockSystem::apply_KT_DT(int n, const VecX& x, const VecX& v, const VecX& y
   DTy.resize(dof());
   parallel_agents(spec_.agents, [&](int j) {
     Vec3 kt, dt;
-    transpose_apply(scratch_, n, x, v, y, j, kt, dt);
+    transpose_apply(n, x, v, y, j, kt, dt);
     seg(KTy, j) = kt;
     seg(DTy, j) = dt;
   });

@@ -4,11 +4,14 @@
 //   v1 = v + h M^-1 (f(x, v) + u),  x1 = x + h v1          (forward)
 //   s = vhat1 + h xhat1,  xhat = xhat1 + h K^T M^-1 s,  vhat = s + h D^T M^-1 s,  uhat = h M^-1 s
 // with K = df/dx, D = df/dv at (x_n, v_n) applied matrix-free. The three neighbour forces run fused in one
-// pass over each agent's list (NeighborForces), each pair's terms computed once (PairIndex) and gathered by
-// both agents in a fixed order, so results do not depend on the thread count; wander and drag are per-agent
-// terms.
-// The forward step records the neighbour lists and centering means it found (FlockRecord, the step's tape
-// entry); its adjoint reads them, so one adjoint step costs one transposed pass and no neighbour search.
+// pass over each agent's whole list (NeighborForces), each agent summing its own pair terms in its list's
+// order, so results do not depend on the thread count; wander and drag are per-agent terms. A pair's terms
+// are computed by both of its agents: at a bunched crowd's hundreds of neighbours, storing them once and
+// reading them back twice moved more memory than computing them again costs.
+// The forward step records the centering quantities it found (FlockRecord, the step's tape entry); its
+// adjoint repeats the neighbour search at the step's state (the same lists, bit for bit) rather than
+// reading them from the tape: the lists are most of a bunched crowd's tape (4 bytes per neighbour entry
+// and step, 1 GB at 10,000 agents) and the search a small part of a step's work.
 // Planar: the y components of x1, v1 and of every adjoint output are exactly zero (y of u is ignored).
 #include <memory>
 #include <vector>
@@ -17,20 +20,16 @@
 #include "sim/flock/flock_force.h"
 #include "sim/flock/neighbor_forces.h"
 #include "sim/flock/neighbor_grid.h"
-#include "sim/flock/pair_buffer.h"
-#include "sim/flock/pair_index.h"
 #include "sim/system.h"
 
 namespace kf {
 
-// What a flock step found at its state: neighbour lists, each pair once under its owner
-// (NeighborGrid::search_owned), and centering quantities (offset m_i - x_i in the ground plane, m, and b_i;
-// p each).
+// What a flock step found at its state that its adjoint cannot cheaply find again: the centering quantities
+// (offset m_i - x_i in the ground plane, m, and b_i; p each).
 struct FlockRecord final : StepRecord {
-  NeighborLists lists;
   std::vector<Planar> offset;
   std::vector<double> b;
-  std::size_t bytes() const { return lists.bytes() + offset.capacity() * sizeof(Planar) + b.capacity() * sizeof(double); }
+  std::size_t bytes() const { return offset.capacity() * sizeof(Planar) + b.capacity() * sizeof(double); }
 };
 
 class FlockSystem final : public System {
@@ -45,9 +44,7 @@ class FlockSystem final : public System {
   void initial_state(VecX& x, VecX& v) const override;
   bool planar() const override { return true; }
   std::unique_ptr<StepRecord> new_record() const override { return std::make_unique<FlockRecord>(); }
-  // Lists (4 bytes per neighbour entry, 8 per agent) and centering quantities (24 bytes per agent). The
-  // entries are twice those at the spawn (agents bunch as they are steered), or a quarter more than the
-  // most any step has found so far, whichever is larger.
+  // Centering quantities: 24 bytes per agent, however the agents bunch.
   std::size_t record_bytes_estimate() const override;
   using System::step;
   using System::step_adjoint;
@@ -64,19 +61,17 @@ class FlockSystem final : public System {
   void apply_KT_DT(int n, const VecX& x, const VecX& v, const VecX& y, VecX& KTy, VecX& DTy);
 
  private:
-  // Fills `r` for x: neighbour search, and the centering quantities when `with_centering` (then motion_
+  // Neighbour search at x into lists_, and r's centering quantities when `with_centering` (then motion_
   // holds x and v packed).
   void search(FlockRecord& r, const VecX& x, const VecX& v, bool with_centering);
-  // Each owned pair's forward terms at the state of r (motion_ packed) into forward_pairs_.
-  void compute_forward_pairs(const FlockRecord& r);
-  // Forward neighbour pass for agent i from forward_pairs_: adds the force to f, records offset_i and b_i.
+  // Forward neighbour pass for agent i over lists_ (motion_ packed): adds the force to f, records offset_i
+  // and b_i.
   void add_neighbor_force(FlockRecord& r, int i, Vec3& f) const;
-  // Packs adjoint_ for the transposed pass at the state of r (motion_ packed), applied to y, and computes
-  // each owned pair's transposed terms into transposed_pairs_.
+  // Packs adjoint_ for the transposed pass at the state of r (motion_ packed), applied to y.
   void pack_adjoint(const FlockRecord& r, const VecX& y);
   void check_size(const VecX& x, const VecX& v) const;
-  // (K^T y)_j and (D^T y)_j of all forces at the state of record r (adjoint_ packed for it).
-  void transpose_apply(const FlockRecord& r, int n, const VecX& x, const VecX& v, const VecX& y, int j, Vec3& kt,
+  // (K^T y)_j and (D^T y)_j of all forces at the state of lists_ (adjoint_ packed for it).
+  void transpose_apply(int n, const VecX& x, const VecX& v, const VecX& y, int j, Vec3& kt,
                        Vec3& dt) const;
   Vec3 local_force(int n, const VecX& v, int i) const;  // wander + drag on agent i
 
@@ -89,14 +84,7 @@ class FlockSystem final : public System {
   NeighborGrid grid_;    // search work space, shared by all steps
   std::vector<AgentMotion> motion_;    // the state being stepped, packed (p)
   std::vector<AgentAdjoint> adjoint_;  // the same with y and the centering quantities (p)
-  PairIndex pair_index_;                // of the lists being evaluated
-  // Per pair (pair_index_), in one buffer: the forward terms of the state last packed, or its transposed ones
-  // (whichever was computed last; the other pointer is null).
-  PairBuffer pair_buffer_;
-  PairForward* forward_pairs_ = nullptr;
-  PairTransposed* transposed_pairs_ = nullptr;
-  int spawn_entries_ = 0;  // neighbour entries at the initial state
-  int most_entries_ = 0;   // the most any step has found
+  NeighborLists lists_;                 // of the state being stepped or adjoined
   FlockRecord scratch_;  // forces() and apply_KT_DT
   VecX y_;  // M^-1 s in the adjoint step
 };

@@ -4,8 +4,6 @@
 #include <cmath>
 
 #include "sim/flock/avoidance_force.h"
-#include "sim/flock/neighbor_lists.h"
-#include "sim/flock/pair_index.h"
 #include "sim/flock/parallel_agents.h"
 #include "sim/flock/smooth_kernel.h"
 
@@ -103,9 +101,6 @@ struct ForwardSum {
   void add(const PairForward& q) {
     s.ax += q.ax, s.az += q.az, s.mx += q.mx, s.mz += q.mz, s.cx -= q.cx, s.cz -= q.cz, s.w += q.w;
   }
-  void add_mirrored(const PairForward& q) {
-    s.ax -= q.ax, s.az -= q.az, s.mx -= q.mx, s.mz -= q.mz, s.cx += q.cx, s.cz += q.cz, s.w += q.w;
-  }
 };
 
 struct TransposedSum {
@@ -114,19 +109,7 @@ struct TransposedSum {
     s.kax += q.kax, s.kaz += q.kaz, s.kmx += q.kmx, s.kmz += q.kmz;
     s.dmx += q.dmx, s.dmz += q.dmz, s.kcx += q.kcx, s.kcz += q.kcz;
   }
-  void add_mirrored(const PairTransposed& q) {
-    s.kax -= q.kax, s.kaz -= q.kaz, s.kmx -= q.kmx, s.kmz -= q.kmz;
-    s.dmx -= q.dmx, s.dmz -= q.dmz, s.kcx -= q.kcx, s.kcz -= q.kcz;
-  }
 };
-
-// Agent i's pair terms in the order of its whole list: those of pairs earlier agents own (mirrored), then
-// its own (slots owned.start(i)...).
-template <class Sum, class Pair>
-void gather_pairs(const NeighborLists& owned, const PairIndex& index, const Pair* pairs, int i, Sum& sum) {
-  for (int k : index.mirrored(i)) sum.add_mirrored(pairs[k]);
-  for (int k = owned.start(i), end = owned.start(i + 1); k < end; ++k) sum.add(pairs[k]);
-}
 
 }  // namespace
 
@@ -152,30 +135,6 @@ void NeighborForces::transpose_apply(const AgentAdjoint* a, std::span<const int>
                                      Planar& dt) const {
   TransposedSum sum;
   for (int i : nbrs) sum.add(transposed_pair(a[j], a[i]));
-  finish_transposed(sum.s, kt, dt);
-}
-
-void NeighborForces::forward_pairs(const AgentMotion* a, const NeighborLists& l, const PairIndex& index, int i,
-                                   PairForward* pairs) const {
-  for (int k = l.start(i), end = l.start(i + 1); k < end; ++k) pairs[k] = forward_pair(a[i], a[l.entry(k)]);
-}
-
-Planar NeighborForces::gather_force(const NeighborLists& l, const PairIndex& index, const PairForward* pairs, int i,
-                                    Planar& offset_i, double& b_i) const {
-  ForwardSum sum;
-  gather_pairs(l, index, pairs, i, sum);
-  return finish_force(sum.s, offset_i, b_i);
-}
-
-void NeighborForces::transposed_pairs(const AgentAdjoint* a, const NeighborLists& l, const PairIndex& index, int j,
-                                      PairTransposed* pairs) const {
-  for (int k = l.start(j), end = l.start(j + 1); k < end; ++k) pairs[k] = transposed_pair(a[j], a[l.entry(k)]);
-}
-
-void NeighborForces::gather_transposed(const NeighborLists& l, const PairIndex& index, const PairTransposed* pairs,
-                                       int j, Planar& kt, Planar& dt) const {
-  TransposedSum sum;
-  gather_pairs(l, index, pairs, j, sum);
   finish_transposed(sum.s, kt, dt);
 }
 

@@ -11,11 +11,6 @@
 // Transposed, for agent j: (K^T y)_j and (D^T y)_j of the three terms, given offset and b of all agents.
 // A term with strength 0 is off; each term's kernel is exactly zero beyond its own radius, so the list
 // may hold neighbours within any larger radius.
-//
-// Each pair once (PairIndex): every pair's terms seen from one agent (PairForward, PairTransposed) are
-// exactly the negation of those seen from the other (all pair formulas are odd in the swap, and IEEE
-// negation and subtraction are exact), so the owner computes them once and both gather them in their own
-// list order: the same sums, bit for bit, as the per-agent passes over whole lists, at half the pair work.
 #include <span>
 #include <vector>
 
@@ -41,21 +36,16 @@ struct Planar {
 };
 
 // One pair's forward terms seen from agent i with neighbour j, before strengths: avoidance w g d, matching
-// w (v_j - v_i), centering w d (subtracted from a_i) and w (added to b_i); d = x_i - x_j. Seen from j: all
-// negated except w.
+// w (v_j - v_i), centering w d (subtracted from a_i) and w (added to b_i); d = x_i - x_j.
 struct PairForward {
   double ax = 0, az = 0, mx = 0, mz = 0, cx = 0, cz = 0, w = 0;
 };
 
 // One pair's transposed terms seen from agent j with neighbour i, as transpose_apply sums them: avoidance and
 // matching shares of K^T y before strengths, matching's of D^T y before its strength, centering's of K^T y.
-// Seen from i: all negated.
 struct PairTransposed {
   double kax = 0, kaz = 0, kmx = 0, kmz = 0, dmx = 0, dmz = 0, kcx = 0, kcz = 0;
 };
-
-class PairIndex;
-class NeighborLists;
 
 class NeighborForces {
  public:
@@ -71,18 +61,6 @@ class NeighborForces {
 
   // a: all agents (y, offsets and c/b filled). Returns (K^T y)_j in kt and (D^T y)_j in dt.
   void transpose_apply(const AgentAdjoint* a, std::span<const int> nbrs, int j, Planar& kt, Planar& dt) const;
-
-  // The same with each pair once, over lists of owned pairs (NeighborGrid::search_owned). First, for every
-  // agent i (in any order, in parallel): the terms of the pairs it owns into pairs[lists.start(i)...]. Then,
-  // for every agent, the gather: equal to force() (respectively transpose_apply()) over its whole list.
-  void forward_pairs(const AgentMotion* a, const NeighborLists& lists, const PairIndex& index, int i,
-                     PairForward* pairs) const;
-  Planar gather_force(const NeighborLists& lists, const PairIndex& index, const PairForward* pairs, int i,
-                      Planar& offset_i, double& b_i) const;
-  void transposed_pairs(const AgentAdjoint* a, const NeighborLists& lists, const PairIndex& index, int j,
-                        PairTransposed* pairs) const;
-  void gather_transposed(const NeighborLists& lists, const PairIndex& index, const PairTransposed* pairs, int j,
-                         Planar& kt, Planar& dt) const;
 
  private:
   PairForward forward_pair(const AgentMotion& ai, const AgentMotion& aj) const;

@@ -23,7 +23,7 @@ int64_t cell_index(double c, double inv_cell) {
 
 }  // namespace
 
-template <bool kWrapped, bool kLater>
+template <bool kWrapped>
 int NeighborGrid::gather_run(int k, int s, int e, int64_t cx0, int64_t cz, double r2, int cap, int* out,
                              int n) const {
   // Branch-free: every candidate is written to the next free entry (or the scratch one) and counted when
@@ -34,49 +34,36 @@ int NeighborGrid::gather_run(int k, int s, int e, int64_t cx0, int64_t cz, doubl
     const double ex = sorted_px_[s] - xi, ez = sorted_pz_[s] - zi;
     bool hit = (ex * ex + ez * ez < r2) & (s != k);
     if constexpr (kWrapped) hit &= (sorted_cz_[s] == cz) & (uint64_t(sorted_cx_[s] - cx0) <= 2 * kReach);
-    if constexpr (kLater)
-      hit &= (sorted_cx_[s] > sorted_cx_[k]) | ((sorted_cx_[s] == sorted_cx_[k]) & (sorted_[s] > sorted_[k]));
     out[n < cap ? n : cap] = sorted_[s];
     n += int(hit);
   }
   return n;
 }
 
-template <bool kWrapped, bool kOwned>
+template <bool kWrapped>
 int NeighborGrid::gather(int k, double r2, int cap, int* out) const {
   const int64_t cx = sorted_cx_[k], cz = sorted_cz_[k];
   int n = 0;
-  // Owned pairs only: rows before k's hold only earlier agents; in k's own row the later ones are, unwrapped,
-  // exactly the slots after k (slots are in the lists' order), wrapped, told apart by cell and agent.
-  for (int64_t row = kOwned ? cz : cz - kReach; row <= cz + kReach; ++row) {
-    const bool own_row = kOwned && row == cz;
+  for (int64_t row = cz - kReach; row <= cz + kReach; ++row) {
     if ((uint64_t(cx - kReach - origin_x_) & column_mask_) + 2 * kReach <= column_mask_) {  // consecutive buckets
       const uint64_t b = bucket_of(cx - kReach, row);
-      int s = bucket_start_[b];
-      const int e = bucket_start_[b + 2 * kReach + 1];
-      if (own_row && !kWrapped) s = k + 1;
-      n = own_row && kWrapped ? gather_run<true, true>(k, s, e, cx - kReach, row, r2, cap, out, n)
-                              : gather_run<kWrapped>(k, s, e, cx - kReach, row, r2, cap, out, n);
+      n = gather_run<kWrapped>(k, bucket_start_[b], bucket_start_[b + 2 * kReach + 1], cx - kReach, row, r2, cap,
+                               out, n);
       continue;
     }
     for (int64_t c = cx - kReach; c <= cx + kReach; ++c) {  // the row wraps: one cell at a time, in column order
       const uint64_t b = bucket_of(c, row);
-      n = own_row ? gather_run<true, true>(k, bucket_start_[b], bucket_start_[b + 1], c, row, r2, cap, out, n)
-                  : gather_run<true>(k, bucket_start_[b], bucket_start_[b + 1], c, row, r2, cap, out, n);
+      n = gather_run<true>(k, bucket_start_[b], bucket_start_[b + 1], c, row, r2, cap, out, n);
     }
   }
   return n;
 }
 
-void NeighborGrid::search(const VecX& x, double radius, NeighborLists& out) { search(x, radius, out, false); }
-
-void NeighborGrid::search_owned(const VecX& x, double radius, NeighborLists& out) { search(x, radius, out, true); }
-
-void NeighborGrid::search(const VecX& x, double radius, NeighborLists& out, bool owned) {
+void NeighborGrid::search(const VecX& x, double radius, NeighborLists& out) {
   const int p = int(x.size() / 3);
   if (int(cell_x_.size()) != p) size_for(p);
   sort_into_buckets(x, radius, p);
-  gather_into_slabs(radius * radius, p, owned);
+  gather_into_slabs(radius * radius, p);
   compact_slabs(p, out);
 }
 
@@ -144,7 +131,7 @@ void NeighborGrid::sort_into_buckets(const VecX& x, double radius, int p) {
   }
 }
 
-void NeighborGrid::gather_into_slabs(double r2, int p, bool owned) {
+void NeighborGrid::gather_into_slabs(double r2, int p) {
   // One pass in bucket order: each agent writes into its own slab of `capacity_` entries; in the rare
   // search where some agent has more neighbours than ever before, the slabs grow and the pass runs again.
   if (capacity_ == 0) capacity_ = 16;
@@ -155,8 +142,7 @@ void NeighborGrid::gather_into_slabs(double r2, int p, bool owned) {
     parallel_agents(p, [&](int k) {
       const int i = sorted_[k];
       int* slab = slab_.data() + size_t(i) * stride;
-      count_[i] = owned ? (wrapped_ ? gather<true, true>(k, r2, cap, slab) : gather<false, true>(k, r2, cap, slab))
-                        : (wrapped_ ? gather<true, false>(k, r2, cap, slab) : gather<false, false>(k, r2, cap, slab));
+      count_[i] = wrapped_ ? gather<true>(k, r2, cap, slab) : gather<false>(k, r2, cap, slab);
     });
     const int most = p ? *std::max_element(count_.begin(), count_.end()) : 0;
     if (most <= capacity_) break;

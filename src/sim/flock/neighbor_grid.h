@@ -27,10 +27,6 @@ class NeighborGrid {
   // x: 3p positions (m; y ignored). Afterwards out.neighbors(i) lists every j != i with
   // (x_i - x_j)^2 + (z_i - z_j)^2 < radius^2, in an order that depends only on x (not on the thread count).
   void search(const VecX& x, double radius, NeighborLists& out);
-  // The same with each pair listed once, by its owner: out.neighbors(i) holds only the neighbours later than
-  // i in out.order() (PairIndex gives each agent the pairs earlier agents own). Half the entries, and rows of
-  // cells before i's are not searched at all.
-  void search_owned(const VecX& x, double radius, NeighborLists& out);
 
   // The same into the grid's own lists.
   void build(const VecX& x, double radius) { search(x, radius, lists_); }
@@ -45,7 +41,7 @@ class NeighborGrid {
   // Origin and shape of the table for the cells of the agents (the bounding box when it fits).
   void fit_table(int p);
   void sort_into_buckets(const VecX& x, double radius, int p);
-  void gather_into_slabs(double r2, int p, bool owned);
+  void gather_into_slabs(double r2, int p);
   void compact_slabs(int p, NeighborLists& out) const;
 
   uint64_t bucket_of(int64_t cx, int64_t cz) const {
@@ -54,14 +50,11 @@ class NeighborGrid {
   // Writes agent sorted_[k]'s neighbours (up to `cap`; out has cap + 1 entries, the last scratch) to out;
   // returns how many it has.
   // kWrapped: the table is wrapped, so candidates' cells are checked.
-  // kOwned: only neighbours later in the lists' order (by cell z, cell x, agent).
-  template <bool kWrapped, bool kOwned>
+  template <bool kWrapped>
   int gather(int k, double r2, int cap, int* out) const;
-  // The agents of slots [s, e) in cell row cz and columns [cx0, cx0 + 2 kReach] within r2 of slot k, appended;
-  // kLater: only those later than slot k's agent in the lists' order (for slot k's own row of a wrapped table).
-  template <bool kWrapped, bool kLater = false>
+  // The agents of slots [s, e) in cell row cz and columns [cx0, cx0 + 2 kReach] within r2 of slot k, appended.
+  template <bool kWrapped>
   int gather_run(int k, int s, int e, int64_t cx0, int64_t cz, double r2, int cap, int* out, int n) const;
-  void search(const VecX& x, double radius, NeighborLists& out, bool owned);
 
   int buckets_ = 0;  // a power of two, at least 16
   int64_t origin_x_ = 0, origin_z_ = 0;  // cell (origin_x_, origin_z_) is bucket 0
