@@ -28,7 +28,9 @@ Problem::Problem(const Scene& scene, const TimeSpec& time, System& sys)
 double Problem::control_scale() const {
   if (std::string(controls_.kind()).rfind("initial", 0) == 0) return 1.0;
   const VecX& m = sys_.masses();
-  return m.size() ? 9.81 * m.mean() : 1.0;
+  // A flock feels no gravity: its own steering forces are about its mass times 1 m/s^2.
+  const double acceleration = sys_.planar() ? 1.0 : 9.81;
+  return m.size() ? acceleration * m.mean() : 1.0;
 }
 
 bool Problem::active(int n) const { return !terms_at_step_[n].empty(); }

@@ -25,7 +25,8 @@ class Problem : public StateCost {
   System& system() { return sys_; }
   VecX initial_guess() const { return controls_.initial_guess(); }
   // A physically modest size of one control variable, what an optimiser's first step may change it by:
-  // the mean particle's weight under standard gravity (N) for forces, 1 m/s for initial velocities.
+  // the mean particle's weight under standard gravity (N) for forces on cloth, its mass times 1 m/s^2 for
+  // forces on a flock, 1 m/s for initial velocities.
   double control_scale() const;
 
   // φ(z); when grad is given, also dφ/dz. A simulation that diverges gives a large finite φ that grows

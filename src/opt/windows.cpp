@@ -94,6 +94,7 @@ StagePlan plan_stages(const Scene& scene) {
     return plan;
   }
   plan.stages = {whole};
+  plan.scaled_first_step = scene.flock.has_value();
   if (o.strategy == "single" || !scene.cloth || o.max_evaluations < 2) return plan;
   const ControlSpec& c = scene.controls;
   if (c.kind == ControlKind::kInitialVelocity) {

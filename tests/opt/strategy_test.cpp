@@ -74,6 +74,17 @@ TEST(Optimizer, AutomaticFirstStepIsTheMeanParticlesWeight) {
   EXPECT_DOUBLE_EQ(Problem(thrown, thrown.time, sys).control_scale(), 1.0);
 }
 
+// A flock feels no gravity: its first trial step is scaled to its mass times 1 m/s^2, not to a weight.
+TEST(Optimizer, FlocksFirstStepIsScaledToTheirMass) {
+  const Scene flock = strategy_scene(R"("flock": {"agents": 4, "mass": 2, "spawn": {"radius": 3}})",
+                                     R"({"kind": "per_frame"})");
+  auto sys = make_system(flock);
+  EXPECT_DOUBLE_EQ(Problem(flock, flock.time, *sys).control_scale(), 2.0);
+  EXPECT_TRUE(plan_stages(flock).scaled_first_step);
+  EXPECT_FALSE(plan_stages(strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"strategy": "single"})"))
+                   .scaled_first_step);
+}
+
 std::vector<int> window_starts(const std::vector<StageSpec>& stages, int scene_from) {
   std::vector<int> starts;
   for (const auto& s : stages) starts.push_back(s.controls ? s.controls->from_frame : scene_from);
