@@ -87,13 +87,12 @@ double gradient_growth(Problem& problem, const VecX& z, int reference) {
 StagePlan plan_stages(const Scene& scene) {
   const OptimizerSpec& o = scene.optimizer;
   StagePlan plan;
-  const StageSpec whole{scene.time.substeps, o.max_evaluations, std::nullopt};
   if (!o.schedule.empty()) {
     plan.stages = o.schedule;
     plan.why = "stages: the scene's schedule";
     return plan;
   }
-  plan.stages = {whole};
+  plan.stages = {{scene.time.substeps, o.max_evaluations, std::nullopt}};  // the whole horizon at once
   plan.scaled_first_step = scene.flock.has_value();
   if (o.strategy == "single" || !scene.cloth || o.max_evaluations < 2) return plan;
   const ControlSpec& c = scene.controls;
