@@ -7,6 +7,7 @@
 #include <random>
 
 #include "report/figure_measures.h"
+#include "scene/scene.h"
 #include "../sim/random_flock.h"
 
 namespace kf {
@@ -63,6 +64,28 @@ TEST(FlockMeasures, PointsCoveredEqualsAllPairs) {
     }
   EXPECT_GT(covered, 1000);
   EXPECT_LT(covered, points / 2);
+}
+
+// A crowd's shape can hold more samples at its coverage spacing than a region may have (100,000): its report
+// coarsens the spacing rather than failing after the optimisation (a 100,000-agent square, 313 m wide).
+TEST(FlockMeasures, AShapeTooLargeForItsSpacingIsMeasuredMoreCoarsely) {
+  const Scene scene = parse_scene(R"({"time": {"frames": 1}, "flock": {"agents": 4, "spawn": {"radius": 2}},
+      "objectives": [{"type": "shape", "frame": 1, "polygon": [[0, 0], [313, 0], [313, 313], [0, 313]]}]})",
+                                  "crowd.json");
+  Trajectory t;
+  t.particles = 4;
+  VecX x(12);
+  x << 1, 0, 1, 2, 0, 2, 400, 0, 1, 3, 0, 3;
+  t.x = {x, x};
+  t.v = {VecX::Zero(12), VecX::Zero(12)};
+  const auto m = figure_measures(scene, t);
+  ASSERT_TRUE(m.is_array() && !m.empty()) << m.dump();
+  EXPECT_DOUBLE_EQ(m[0]["inside_fraction"].get<double>(), 0.75);
+  const double spacing = m[0]["coverage_spacing"].get<double>();
+  EXPECT_GT(spacing, 0.75);
+  EXPECT_LE(std::pow(std::round(313 / spacing), 2), 1e5);
+  EXPECT_GT(m[0]["coverage_fraction"].get<double>(), 0.0);
+  EXPECT_LT(m[0]["coverage_fraction"].get<double>(), 1e-3);
 }
 
 }  // namespace
