@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
-#include <tuple>
 
 #include "core/check.h"
 #include "sim/flock/parallel_agents.h"
@@ -163,12 +162,6 @@ void NeighborGrid::compact_slabs(int p, NeighborLists& out) const {
   parallel_agents(p, [&](int i) {
     std::copy_n(slab_.data() + size_t(i) * (size_t(capacity_) + 1), count_[i], out.entries_.data() + out.start_[i]);
   });
-  // The lists' order: by cell (z, then x), then by agent. Unwrapped, that is the bucket order already.
-  out.order_.assign(sorted_.begin(), sorted_.begin() + p);
-  if (wrapped_)
-    std::sort(out.order_.begin(), out.order_.end(), [&](int a, int b) {
-      return std::tie(cell_z_[a], cell_x_[a], a) < std::tie(cell_z_[b], cell_x_[b], b);
-    });
 }
 
 }  // namespace kf
