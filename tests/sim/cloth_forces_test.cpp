@@ -216,7 +216,9 @@ TEST(ClothSpring, DefiniteJacobianIsPositiveSemidefinite) {
     Eigen::SelfAdjointEigenSolver<Mat3> eig(spring_jacobian(s, x, true));
     EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-12) << "ratio " << ratio;
     Eigen::SelfAdjointEigenSolver<Mat3> exact(spring_jacobian(s, x, false));
-    if (ratio < 1) EXPECT_LT(exact.eigenvalues().minCoeff(), 0);  // what the definite form removes
+    if (ratio < 1) {
+      EXPECT_LT(exact.eigenvalues().minCoeff(), 0);  // what the definite form removes
+    }
   }
 }
 
