@@ -84,14 +84,35 @@ Vec2 closest_point_in_polygon(const GroundRegion& region, const Vec2& q, bool* i
   return closest_point_on_boundary(region, q);
 }
 
+namespace {
+
+// The outer loop's bounding box and the grid of `spacing` region_samples lays over it.
+struct SampleGrid {
+  Vec2 lo, hi;
+  int nx = 1, nz = 1;
+  SampleGrid(const std::vector<Vec2>& polygon, double spacing) : lo(polygon.front()), hi(lo) {
+    for (const Vec2& p : polygon) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    nx = std::max(1, int(std::lround((hi.x() - lo.x()) / spacing)));
+    nz = std::max(1, int(std::lround((hi.y() - lo.y()) / spacing)));
+  }
+  bool too_many() const { return double(nx) * nz > kMaxRegionSamples; }
+  static constexpr double kMaxRegionSamples = 1e5;
+};
+
+}  // namespace
+
+double sample_spacing_within_limit(const GroundRegion& region, double spacing) {
+  while (SampleGrid(region.outer, spacing).too_many()) spacing *= 1.05;
+  return spacing;
+}
+
 std::vector<Vec2> region_samples(const GroundRegion& region, double spacing) {
   const std::vector<Vec2>& polygon = region.outer;
-  Vec2 lo = polygon.front(), hi = lo;
-  for (const Vec2& p : polygon) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
   // Cell centres of a grid over the bounding box, so opposite sides are sampled alike.
-  const int nx = std::max(1, int(std::lround((hi.x() - lo.x()) / spacing))),
-            nz = std::max(1, int(std::lround((hi.y() - lo.y()) / spacing)));
-  if (double(nx) * nz > 1e5)
+  const SampleGrid grid(polygon, spacing);
+  const Vec2 lo = grid.lo, hi = grid.hi;
+  const int nx = grid.nx, nz = grid.nz;
+  if (grid.too_many())
     throw InputError("shape keyframe: coverage spacing " + std::to_string(spacing) + " m gives more than 100,000 samples");
   const Vec2 start = 0.5 * (lo + hi) - 0.5 * spacing * Vec2(nx - 1, nz - 1);
   std::vector<Vec2> out;

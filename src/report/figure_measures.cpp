@@ -80,19 +80,6 @@ double median(std::vector<double> v) {
 
 namespace {
 
-// The keyframe's coverage spacing, coarsened until its region's bounding box holds at most the 100,000
-// samples region_samples allows: a crowd's shape may be far larger than the spacing was chosen for, and a
-// report must not fail after the optimisation it reports.
-double measure_spacing(const std::vector<Vec2>& polygon, double spacing) {
-  Vec2 lo = polygon.front(), hi = lo;
-  for (const Vec2& p : polygon) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  const auto samples = [&](double s) {
-    return std::max(1.0, std::round((hi.x() - lo.x()) / s)) * std::max(1.0, std::round((hi.y() - lo.y()) / s));
-  };
-  while (samples(spacing) > 1e5) spacing *= 1.05;
-  return spacing;
-}
-
 // Each keyframe type's measures at its frame f (x = t.x[f]), added to m.
 void shape_measures(const ShapeKeyframe& k, const VecX& x, nlohmann::json& m) {
   const GroundRegion region(k.polygon, k.holes);
@@ -104,7 +91,9 @@ void shape_measures(const ShapeKeyframe& k, const VecX& x, nlohmann::json& m) {
   m["min_spacing"] = *std::min_element(nn.begin(), nn.end());
   m["median_spacing"] = median(nn);
   // Filled, not clumped: the fraction of the region's sample points with an agent within the radius.
-  const double spacing = measure_spacing(k.polygon, k.coverage_spacing);
+  // A crowd's shape may need more samples at its spacing than a region may have: measured more coarsely, so
+  // the report does not fail after the optimisation it reports.
+  const double spacing = sample_spacing_within_limit(region, k.coverage_spacing);
   const std::vector<Vec2> samples = region_samples(region, spacing);
   const std::vector<char> near = points_covered(x, samples, k.coverage_radius);
   const int covered = int(std::count(near.begin(), near.end(), char(1)));
