@@ -453,6 +453,7 @@ std::string set_up_stage(const JobContext& c, const StageSpec& stage, JobResult&
   std::string memory_line;
   // Besides the optimiser and the rollout: the recorded evaluations (points and gradients, for a resume)
   // and, at the end, the run directory's two trajectories (the uncontrolled run and the result).
+  job.tape.expect(std::uint64_t(problem.size()), c.all_evaluations);
   const std::size_t held =
       job.tape.bytes_for(std::uint64_t(problem.size()), c.all_evaluations) +
       2 * std::size_t(c.scene.time.frames + 1) * 2 * std::size_t(job.sys->dof()) * sizeof(double);

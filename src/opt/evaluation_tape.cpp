@@ -48,13 +48,14 @@ const RecordedEvaluation* EvaluationTape::replay(const VecX& z) {
 void EvaluationTape::record(RecordedEvaluation e) {
   if (!complete_) return;
   bytes_ += 16 * std::uint64_t(e.z.size()) + 64;
-  if (bytes_ > max_bytes_) {
-    complete_ = false;
-    records_.clear();
-    records_.shrink_to_fit();
-    return;
-  }
+  if (bytes_ > max_bytes_) return stop_recording();
   records_.push_back(std::move(e));
+}
+
+void EvaluationTape::stop_recording() {
+  complete_ = false;
+  records_.clear();
+  records_.shrink_to_fit();
 }
 
 void save_evaluations(const std::filesystem::path& path, const std::vector<RecordedEvaluation>& records) {

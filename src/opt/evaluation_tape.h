@@ -38,12 +38,19 @@ class EvaluationTape {
   bool complete() const { return complete_; }  // false when the size limit stopped the recording
   const std::vector<RecordedEvaluation>& records() const { return records_; }
   int replayed() const { return int(next_); }
+  // Stops recording for good when `evaluations` evaluations of n controls could pass the size limit: such
+  // a tape would be dropped part way, having held its memory for nothing.
+  void expect(std::uint64_t n, std::uint64_t evaluations) {
+    if ((16 * n + 64) * evaluations > max_bytes_) stop_recording();
+  }
   // The most this tape holds while recording `evaluations` evaluations of n controls (bytes).
   std::uint64_t bytes_for(std::uint64_t n, std::uint64_t evaluations) const {
-    return std::min(max_bytes_, (16 * n + 64) * evaluations);
+    return complete_ ? std::min(max_bytes_, (16 * n + 64) * evaluations) : 0;
   }
 
  private:
+  void stop_recording();
+
   std::vector<RecordedEvaluation> records_, replay_;
   size_t next_ = 0;
   bool replaying_ = true, complete_ = true;

@@ -41,45 +41,58 @@ void FlockSystem::check_size(const VecX& x, const VecX& v) const {
   CHECK_EQ(v.size(), dof());
 }
 
-void FlockSystem::search(FlockRecord& r, const VecX& x, const VecX& v, bool with_centering) {
+namespace {
+// One thread's list of a slot's neighbour slots, reused by every pass: it grows with the densest
+// neighbourhood met and is never freed, so a pass allocates nothing once the flock has been seen.
+std::vector<int>& slot_scratch() {
+  thread_local std::vector<int> slots;
+  return slots;
+}
+// Wander and drag read neither neighbours nor x; FlockState is only their calling convention.
+const NeighborLists kNoLists;
+}  // namespace
+
+void FlockSystem::index(const VecX& x, const VecX& v) {
+  const int p = spec_.agents;
+  if (!neighbor_forces_.any()) return;
+  grid_.index(x, neighbor_forces_.radius());
+  parallel_agents(p, [&](int k) {
+    const int i = grid_.agent_at(k);
+    motion_[k] = {x[3 * i], x[3 * i + 2], v[3 * i], v[3 * i + 2]};
+  });
+}
+
+void FlockSystem::size_record(FlockRecord& r) const {
   const int p = spec_.agents;
   if (int(r.b.size()) != p) {
     r.offset.resize(p);
     r.b.resize(p);
   }
-  if (!neighbor_forces_.any()) {
-    std::fill(r.offset.begin(), r.offset.end(), Planar{});
-    std::fill(r.b.begin(), r.b.end(), 1.0);
-    return;
-  }
-  grid_.search(x, neighbor_forces_.radius(), lists_);
-  if (with_centering) {
-    pack_motion(x, v, motion_);
-    parallel_agents(p, [&](int i) {
-      neighbor_forces_.force(motion_.data(), lists_.neighbors(i), i, r.offset[i], r.b[i]);
-    });
-  }
 }
 
-void FlockSystem::add_neighbor_force(FlockRecord& r, int i, Vec3& f) const {
-  if (!neighbor_forces_.any()) return;
-  const Planar fn = neighbor_forces_.force(motion_.data(), lists_.neighbors(i), i, r.offset[i], r.b[i]);
-  f.x() += fn.x;
-  f.z() += fn.z;
+Planar FlockSystem::neighbor_force(FlockRecord& r, int k, int i) const {
+  if (!neighbor_forces_.any()) {
+    r.offset[i] = Planar{};
+    r.b[i] = 1.0;
+    return Planar{};
+  }
+  std::vector<int>& slots = slot_scratch();
+  const int n = grid_.neighbors_of_slot(k, slots);
+  return neighbor_forces_.force(motion_.data(), {slots.data(), size_t(n)}, k, r.offset[i], r.b[i]);
 }
 
 void FlockSystem::pack_adjoint(const FlockRecord& r, const VecX& y) {
+  if (!neighbor_forces_.any()) return;
   const double c = neighbor_forces_.centering_strength();
-  parallel_agents(spec_.agents, [&](int i) {
-    const AgentMotion& m = motion_[i];
-    adjoint_[i] = {m.x, m.z, m.vx, m.vz, y[3 * i], y[3 * i + 2], r.offset[i].x, r.offset[i].z, c / r.b[i]};
+  parallel_agents(spec_.agents, [&](int k) {
+    const int i = grid_.agent_at(k);
+    const AgentMotion& m = motion_[k];
+    adjoint_[k] = {m.x, m.z, m.vx, m.vz, y[3 * i], y[3 * i + 2], r.offset[i].x, r.offset[i].z, c / r.b[i]};
   });
 }
 
 Vec3 FlockSystem::local_force(int n, const VecX& v, int i) const {
-  // Wander and drag read neither neighbours nor x; FlockState is only their calling convention.
-  static const NeighborLists kNone;
-  const FlockState s{n, v, v, kNone};
+  const FlockState s{n, v, v, kNoLists};
   Vec3 f = Vec3::Zero();
   for (const auto& force : local_forces_) force->add_force(s, i, f);
   return f;
@@ -89,13 +102,16 @@ bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
                        StepRecord& record) {
   check_size(x, v);
   FlockRecord& r = static_cast<FlockRecord&>(record);
-  search(r, x, v, false);  // the step fills the centering quantities itself
-  pack_motion(x, v, motion_);
+  size_record(r);
+  index(x, v);
   x_next.resize(dof());
   v_next.resize(dof());
-  parallel_agents(spec_.agents, [&](int i) {
+  parallel_agents(spec_.agents, [&](int k) {
+    const int i = agent(k);
     Vec3 f = seg(u, i) + local_force(n, v, i);
-    add_neighbor_force(r, i, f);
+    const Planar fn = neighbor_force(r, k, i);
+    f.x() += fn.x;
+    f.z() += fn.z;
     Vec3 v1 = seg(v, i) + (h_ / masses_[i]) * f;
     v1.y() = 0;
     Vec3 x1 = seg(x, i) + h_ * v1;
@@ -106,18 +122,20 @@ bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
   return x_next.allFinite() && v_next.allFinite();
 }
 
-void FlockSystem::transpose_apply(int n, const VecX& x, const VecX& v, const VecX& y, int j,
-                                  Vec3& kt, Vec3& dt) const {
+void FlockSystem::transpose_apply(int n, const VecX& x, const VecX& v, const VecX& y, int k, int j, Vec3& kt,
+                                  Vec3& dt) const {
   kt.setZero();
   dt.setZero();
   if (neighbor_forces_.any()) {
-    Planar k, d;
-    neighbor_forces_.transpose_apply(adjoint_.data(), lists_.neighbors(j), j, k, d);
-    kt = Vec3(k.x, 0, k.z);
-    dt = Vec3(d.x, 0, d.z);
+    std::vector<int>& slots = slot_scratch();
+    const int count = grid_.neighbors_of_slot(k, slots);
+    Planar kp, dp;
+    neighbor_forces_.transpose_apply(adjoint_.data(), {slots.data(), size_t(count)}, k, kp, dp);
+    kt = Vec3(kp.x, 0, kp.z);
+    dt = Vec3(dp.x, 0, dp.z);
   }
   // Local forces only through their interface, so a new one cannot drop out of the adjoint.
-  const FlockState s{n, x, v, lists_};
+  const FlockState s{n, x, v, kNoLists};
   for (const auto& force : local_forces_) {
     force->add_KT(s, y, j, kt);
     force->add_DT(s, y, j, dt);
@@ -135,15 +153,15 @@ void FlockSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX&,
     si.y() = 0;
     seg(y_, i) = si / masses_[i];
   });
-  if (neighbor_forces_.any()) grid_.search(x, neighbor_forces_.radius(), lists_);  // the step's own lists
-  pack_motion(x, v, motion_);
+  index(x, v);  // the step's own slots and neighbours
   pack_adjoint(r, y_);
   xhat.resize(dof());
   vhat.resize(dof());
   uhat.resize(dof());
-  parallel_agents(p, [&](int j) {
+  parallel_agents(p, [&](int k) {
+    const int j = agent(k);
     Vec3 kt, dt;
-    transpose_apply(n, x, v, y_, j, kt, dt);
+    transpose_apply(n, x, v, y_, k, j, kt, dt);
     const Vec3 yj = seg(y_, j);
     Vec3 xh = seg(xhat1, j) + h_ * kt;
     Vec3 vh = seg(vhat1, j) + h_ * seg(xhat1, j) + h_ * dt;  // s_j + h (D^T M^-1 s)_j
@@ -157,25 +175,31 @@ void FlockSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX&,
 
 void FlockSystem::forces(int n, const VecX& x, const VecX& v, VecX& f) {
   check_size(x, v);
-  search(scratch_, x, v, false);
-  pack_motion(x, v, motion_);
+  size_record(scratch_);
+  index(x, v);
   f.resize(dof());
-  parallel_agents(spec_.agents, [&](int i) {
+  parallel_agents(spec_.agents, [&](int k) {
+    const int i = agent(k);
     Vec3 fi = local_force(n, v, i);
-    add_neighbor_force(scratch_, i, fi);
+    const Planar fn = neighbor_force(scratch_, k, i);
+    fi.x() += fn.x;
+    fi.z() += fn.z;
     seg(f, i) = fi;
   });
 }
 
 void FlockSystem::apply_KT_DT(int n, const VecX& x, const VecX& v, const VecX& y, VecX& KTy, VecX& DTy) {
   check_size(x, v);
-  search(scratch_, x, v, true);
+  size_record(scratch_);
+  index(x, v);
+  parallel_agents(spec_.agents, [&](int k) { neighbor_force(scratch_, k, agent(k)); });  // centering quantities
   pack_adjoint(scratch_, y);
   KTy.resize(dof());
   DTy.resize(dof());
-  parallel_agents(spec_.agents, [&](int j) {
+  parallel_agents(spec_.agents, [&](int k) {
+    const int j = agent(k);
     Vec3 kt, dt;
-    transpose_apply(n, x, v, y, j, kt, dt);
+    transpose_apply(n, x, v, y, k, j, kt, dt);
     seg(KTy, j) = kt;
     seg(DTy, j) = dt;
   });

@@ -11,7 +11,9 @@
 // The forward step records the centering quantities it found (FlockRecord, the step's tape entry); its
 // adjoint repeats the neighbour search at the step's state (the same lists, bit for bit) rather than
 // reading them from the tape: the lists are most of a bunched crowd's tape (4 bytes per neighbour entry
-// and step, 1 GB at 10,000 agents) and the search a small part of a step's work.
+// and step, 1 GB at 10,000 agents) and the search a small part of a step's work. Each pass finds an
+// agent's list just before it uses it (NeighborGrid::neighbors_of_slot) and keeps none, over agent data
+// packed in the grid's slot order.
 // Planar: the y components of x1, v1 and of every adjoint output are exactly zero (y of u is ignored).
 #include <memory>
 #include <vector>
@@ -61,17 +63,18 @@ class FlockSystem final : public System {
   void apply_KT_DT(int n, const VecX& x, const VecX& v, const VecX& y, VecX& KTy, VecX& DTy);
 
  private:
-  // Neighbour search at x into lists_, and r's centering quantities when `with_centering` (then motion_
-  // holds x and v packed).
-  void search(FlockRecord& r, const VecX& x, const VecX& v, bool with_centering);
-  // Forward neighbour pass for agent i over lists_ (motion_ packed): adds the force to f, records offset_i
-  // and b_i.
-  void add_neighbor_force(FlockRecord& r, int i, Vec3& f) const;
-  // Packs adjoint_ for the transposed pass at the state of r (motion_ packed), applied to y.
+  // Sorts the agents at x into the grid's slots and packs motion_ in slot order (nothing without
+  // neighbour forces: then slot k is agent k).
+  void index(const VecX& x, const VecX& v);
+  int agent(int k) const { return neighbor_forces_.any() ? grid_.agent_at(k) : k; }
+  void size_record(FlockRecord& r) const;
+  // Forward neighbour pass for the agent i in slot k (motion_ packed): its force, and r's offset_i, b_i.
+  Planar neighbor_force(FlockRecord& r, int k, int i) const;
+  // Packs adjoint_ in slot order for the transposed pass at the state of r (motion_ packed), applied to y.
   void pack_adjoint(const FlockRecord& r, const VecX& y);
   void check_size(const VecX& x, const VecX& v) const;
-  // (K^T y)_j and (D^T y)_j of all forces at the state of lists_ (adjoint_ packed for it).
-  void transpose_apply(int n, const VecX& x, const VecX& v, const VecX& y, int j, Vec3& kt,
+  // (K^T y)_j and (D^T y)_j of all forces for the agent j in slot k (adjoint_ packed).
+  void transpose_apply(int n, const VecX& x, const VecX& v, const VecX& y, int k, int j, Vec3& kt,
                        Vec3& dt) const;
   Vec3 local_force(int n, const VecX& v, int i) const;  // wander + drag on agent i
 
@@ -81,10 +84,9 @@ class FlockSystem final : public System {
   VecX masses_;
   NeighborForces neighbor_forces_;
   std::vector<std::unique_ptr<FlockForce>> local_forces_;  // per-agent terms: wander, drag
-  NeighborGrid grid_;    // search work space, shared by all steps
-  std::vector<AgentMotion> motion_;    // the state being stepped, packed (p)
+  NeighborGrid grid_;    // the state being stepped or adjoined, sorted into slots
+  std::vector<AgentMotion> motion_;    // that state, packed in slot order (p)
   std::vector<AgentAdjoint> adjoint_;  // the same with y and the centering quantities (p)
-  NeighborLists lists_;                 // of the state being stepped or adjoined
   FlockRecord scratch_;  // forces() and apply_KT_DT
   VecX y_;  // M^-1 s in the adjoint step
 };

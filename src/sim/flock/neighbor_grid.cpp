@@ -33,7 +33,7 @@ int NeighborGrid::gather_run(int k, int s, int e, int64_t cx0, int64_t cz, doubl
     const double ex = sorted_px_[s] - xi, ez = sorted_pz_[s] - zi;
     bool hit = (ex * ex + ez * ez < r2) & (s != k);
     if constexpr (kWrapped) hit &= (sorted_cz_[s] == cz) & (uint64_t(sorted_cx_[s] - cx0) <= 2 * kReach);
-    out[n < cap ? n : cap] = sorted_[s];
+    out[n < cap ? n : cap] = s;
     n += int(hit);
   }
   return n;
@@ -59,11 +59,27 @@ int NeighborGrid::gather(int k, double r2, int cap, int* out) const {
 }
 
 void NeighborGrid::search(const VecX& x, double radius, NeighborLists& out) {
+  index(x, radius);
+  const int p = int(sorted_.size());
+  gather_into_slabs(p);
+  compact_slabs(p, out);
+}
+
+void NeighborGrid::index(const VecX& x, double radius) {
   const int p = int(x.size() / 3);
   if (int(cell_x_.size()) != p) size_for(p);
+  r2_ = radius * radius;
   sort_into_buckets(x, radius, p);
-  gather_into_slabs(radius * radius, p);
-  compact_slabs(p, out);
+}
+
+int NeighborGrid::neighbors_of_slot(int slot, std::vector<int>& out) const {
+  for (;;) {  // at most twice: a first gather that overflows says how many there are
+    if (out.size() < 2) out.resize(64);
+    const int cap = int(out.size()) - 1;
+    const int n = wrapped_ ? gather<true>(slot, r2_, cap, out.data()) : gather<false>(slot, r2_, cap, out.data());
+    if (n <= cap) return n;
+    out.resize(size_t(n) + size_t(n) / 2 + 2);
+  }
 }
 
 void NeighborGrid::size_for(int p) {
@@ -130,7 +146,7 @@ void NeighborGrid::sort_into_buckets(const VecX& x, double radius, int p) {
   }
 }
 
-void NeighborGrid::gather_into_slabs(double r2, int p) {
+void NeighborGrid::gather_into_slabs(int p) {
   // One pass in bucket order: each agent writes into its own slab of `capacity_` entries; in the rare
   // search where some agent has more neighbours than ever before, the slabs grow and the pass runs again.
   if (capacity_ == 0) capacity_ = 16;
@@ -141,7 +157,7 @@ void NeighborGrid::gather_into_slabs(double r2, int p) {
     parallel_agents(p, [&](int k) {
       const int i = sorted_[k];
       int* slab = slab_.data() + size_t(i) * stride;
-      count_[i] = wrapped_ ? gather<true>(k, r2, cap, slab) : gather<false>(k, r2, cap, slab);
+      count_[i] = wrapped_ ? gather<true>(k, r2_, cap, slab) : gather<false>(k, r2_, cap, slab);
     });
     const int most = p ? *std::max_element(count_.begin(), count_.end()) : 0;
     if (most <= capacity_) break;
@@ -160,7 +176,9 @@ void NeighborGrid::compact_slabs(int p, NeighborLists& out) const {
   out.start_[p] = int(total);
   out.entries_.resize(size_t(total));
   parallel_agents(p, [&](int i) {
-    std::copy_n(slab_.data() + size_t(i) * (size_t(capacity_) + 1), count_[i], out.entries_.data() + out.start_[i]);
+    const int* slab = slab_.data() + size_t(i) * (size_t(capacity_) + 1);
+    int* entries = out.entries_.data() + out.start_[i];
+    for (int e = 0; e < count_[i]; ++e) entries[e] = sorted_[slab[e]];
   });
 }
 

@@ -30,6 +30,14 @@ class NeighborGrid {
 
   // The same into the grid's own lists.
   void build(const VecX& x, double radius) { search(x, radius, lists_); }
+
+  // Slot by slot, for passes that use each list at once and keep none: `index` sorts the agents at x into
+  // slots (the table's bucket order), and `neighbors_of_slot` then writes the slots of one slot's
+  // neighbours within `radius` into out (grown as needed), in the order search lists them, and returns how
+  // many. A pass over agents' data packed in slot order then reads neighbours close together in memory.
+  void index(const VecX& x, double radius);
+  int agent_at(int slot) const { return sorted_[slot]; }
+  int neighbors_of_slot(int slot, std::vector<int>& out) const;
   const NeighborLists& lists() const { return lists_; }
   int agents() const { return lists_.agents(); }
   std::span<const int> neighbors(int i) const { return lists_.neighbors(i); }
@@ -41,14 +49,14 @@ class NeighborGrid {
   // Origin and shape of the table for the cells of the agents (the bounding box when it fits).
   void fit_table(int p);
   void sort_into_buckets(const VecX& x, double radius, int p);
-  void gather_into_slabs(double r2, int p);
+  void gather_into_slabs(int p);
   void compact_slabs(int p, NeighborLists& out) const;
 
   uint64_t bucket_of(int64_t cx, int64_t cz) const {
     return ((uint64_t(cz - origin_z_) & row_mask_) << row_shift_) | (uint64_t(cx - origin_x_) & column_mask_);
   }
-  // Writes agent sorted_[k]'s neighbours (up to `cap`; out has cap + 1 entries, the last scratch) to out;
-  // returns how many it has.
+  // Writes the slots of slot k's neighbours (up to `cap`; out has cap + 1 entries, the last scratch) to
+  // out; returns how many it has.
   // kWrapped: the table is wrapped, so candidates' cells are checked.
   template <bool kWrapped>
   int gather(int k, double r2, int cap, int* out) const;
@@ -56,6 +64,7 @@ class NeighborGrid {
   template <bool kWrapped>
   int gather_run(int k, int s, int e, int64_t cx0, int64_t cz, double r2, int cap, int* out, int n) const;
 
+  double r2_ = 0;    // squared radius of the last index
   int buckets_ = 0;  // a power of two, at least 16
   int64_t origin_x_ = 0, origin_z_ = 0;  // cell (origin_x_, origin_z_) is bucket 0
   uint64_t column_mask_ = 0, row_mask_ = 0;  // columns - 1, rows - 1 (columns x rows = buckets_)
@@ -71,7 +80,7 @@ class NeighborGrid {
   std::vector<double> sorted_px_, sorted_pz_;
   std::vector<int> count_;  // neighbours per agent
   int capacity_ = 0;        // neighbours a slab holds
-  std::vector<int> slab_;   // p slabs of capacity_ + 1 entries, compacted into the lists
+  std::vector<int> slab_;   // p slabs of capacity_ + 1 slots, compacted into the lists as agents
   NeighborLists lists_;
 };
 
