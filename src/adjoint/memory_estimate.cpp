@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 
 namespace kf {
 
@@ -49,6 +50,14 @@ std::size_t physical_memory_bytes() {
 std::size_t default_memory_budget() {
   const std::size_t phys = physical_memory_bytes();
   return phys ? phys / 2 : std::size_t(8) << 30;
+}
+
+std::size_t resident_bytes() {
+  std::ifstream statm("/proc/self/statm");  // pages: total, resident, ...
+  std::size_t total = 0, resident = 0;
+  const long page = sysconf(_SC_PAGE_SIZE);
+  if (!(statm >> total >> resident) || page <= 0) return 0;
+  return resident * std::size_t(page);
 }
 
 }  // namespace kf

@@ -38,5 +38,8 @@ int checkpoint_spacing_for(const MemoryEstimate& e, std::size_t budget, bool& fi
 // or 8 GB when unknown.
 std::size_t physical_memory_bytes();
 std::size_t default_memory_budget();
+// What this process holds in memory now (bytes; 0 when unknown): code, libraries, the scene, work space,
+// which a run's budget must leave room for besides what it plans.
+std::size_t resident_bytes();
 
 }  // namespace kf

@@ -451,11 +451,12 @@ std::string set_up_stage(const JobContext& c, const StageSpec& stage, JobResult&
                                                                 : default_memory_budget();
   job.memory_budget_gb = budget / 1e9;
   std::string memory_line;
-  // Besides the optimiser and the rollout: the recorded evaluations (points and gradients, for a resume)
-  // and, at the end, the run directory's two trajectories (the uncontrolled run and the result).
+  // Besides the optimiser and the rollout: what the process already holds, the recorded evaluations (points
+  // and gradients, for a resume) and, at the end, the run directory's two trajectories (the uncontrolled run
+  // and the result).
   job.tape.expect(std::uint64_t(problem.size()), c.all_evaluations);
   const std::size_t held =
-      job.tape.bytes_for(std::uint64_t(problem.size()), c.all_evaluations) +
+      resident_bytes() + job.tape.bytes_for(std::uint64_t(problem.size()), c.all_evaluations) +
       2 * std::size_t(c.scene.time.frames + 1) * 2 * std::size_t(job.sys->dof()) * sizeof(double);
   problem.set_memory_budget(rollout_budget(problem, *job.sys, c.scene.optimizer.memory, held, budget,
                                            job.auto_checkpoint_every, memory_line));

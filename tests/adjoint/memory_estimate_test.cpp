@@ -1,6 +1,8 @@
 // The memory estimate made before a run, and checkpointing switched on by a budget.
 #include <gtest/gtest.h>
 
+#include <vector>
+
 #include "adjoint/memory_estimate.h"
 #include "opt/problem.h"
 #include "scene/scene.h"
@@ -47,6 +49,15 @@ TEST(MemoryEstimate, SpacingNeedsLeastMemoryOfAllSpacings) {
 TEST(MemoryEstimate, MachineHasMemory) {
   EXPECT_GT(physical_memory_bytes(), std::size_t(1) << 28);
   EXPECT_EQ(default_memory_budget(), physical_memory_bytes() / 2);
+}
+
+TEST(MemoryEstimate, ResidentMemoryGrowsWithWhatIsHeld) {
+  const std::size_t before = resident_bytes();
+  EXPECT_GT(before, std::size_t(1) << 20) << "the process's own code is resident";
+  EXPECT_LT(before, physical_memory_bytes());
+  std::vector<char> held(std::size_t(64) << 20, 1);  // touched, so resident
+  EXPECT_GE(resident_bytes(), before + (std::size_t(60) << 20));
+  EXPECT_EQ(held[12345], 1);
 }
 
 Scene flock_scene(int agents) {
