@@ -30,17 +30,22 @@ NeighborForces::NeighborForces(const FlockSpec& s)
   if (kc_ > 0) radius_ = std::max(radius_, s.centering.radius);
 }
 
-// d = x_i - x_j. The branches skip terms out of reach (their kernel weight is zero there anyway).
-inline PairForward NeighborForces::forward_pair(const AgentMotion& ai, const AgentMotion& aj) const {
-  PairForward q;
+// d = x_i - x_j. Avoidance, for a neighbour within its radius: w g d.
+inline void NeighborForces::forward_avoidance(const AgentMotion& ai, const AgentMotion& aj, PairForward& q) const {
   const double dx = ai.x - aj.x, dz = ai.z - aj.z;
   const double r2 = dx * dx + dz * dz;
-  if (r2 < ra2_) {  // avoidance: w g d
-    const KernelWeight k = smooth_kernel_inv(r2, inv_ra2_);
-    const double wg = k.w / std::sqrt(r2 + eps2_);
-    q.ax = wg * dx;
-    q.az = wg * dz;
-  }
+  const KernelWeight k = smooth_kernel_inv(r2, inv_ra2_);
+  const double wg = k.w / std::sqrt(r2 + eps2_);
+  q.ax = wg * dx;
+  q.az = wg * dz;
+}
+
+// Matching and centering; returns r2. The branches skip terms out of reach (their kernel weight is zero
+// there anyway); when the list's radius is theirs, they are always taken.
+inline double NeighborForces::forward_matching_centering(const AgentMotion& ai, const AgentMotion& aj,
+                                                         PairForward& q) const {
+  const double dx = ai.x - aj.x, dz = ai.z - aj.z;
+  const double r2 = dx * dx + dz * dz;
   double wm = 0;
   if (r2 < rm2_) {  // matching: w (v_j - v_i)
     wm = smooth_kernel_inv(r2, inv_rm2_).w;
@@ -53,23 +58,28 @@ inline PairForward NeighborForces::forward_pair(const AgentMotion& ai, const Age
     q.cz = w * dz;
     q.w = w;
   }
-  return q;
+  return r2;
 }
 
-// d = x_j - x_i.
-inline PairTransposed NeighborForces::transposed_pair(const AgentAdjoint& aj, const AgentAdjoint& ai) const {
-  PairTransposed q;
+// d = x_j - x_i. Avoidance, for a neighbour within its radius: J(d) e with e = y_j - y_i,
+// J = w g I + 2 (w' g + w g') d d^T, g = (r2 + eps^2)^-1/2.
+inline void NeighborForces::transposed_avoidance(const AgentAdjoint& aj, const AgentAdjoint& ai,
+                                                 PairTransposed& q) const {
   const double dx = aj.x - ai.x, dz = aj.z - ai.z;
   const double r2 = dx * dx + dz * dz;
-  if (r2 < ra2_) {
-    // J(d) e with e = y_j - y_i: J = w g I + 2 (w' g + w g') d d^T, g = (r2 + eps^2)^-1/2.
-    const KernelWeight k = smooth_kernel_inv(r2, inv_ra2_);
-    const double g = 1.0 / std::sqrt(r2 + eps2_);
-    const double ex = aj.yx - ai.yx, ez = aj.yz - ai.yz;
-    const double wg = k.w * g, s = 2.0 * (k.dw_dr2 * g - 0.5 * k.w * g * g * g) * (dx * ex + dz * ez);
-    q.kax = wg * ex + s * dx;
-    q.kaz = wg * ez + s * dz;
-  }
+  const KernelWeight k = smooth_kernel_inv(r2, inv_ra2_);
+  const double g = 1.0 / std::sqrt(r2 + eps2_);
+  const double ex = aj.yx - ai.yx, ez = aj.yz - ai.yz;
+  const double wg = k.w * g, s = 2.0 * (k.dw_dr2 * g - 0.5 * k.w * g * g * g) * (dx * ex + dz * ez);
+  q.kax = wg * ex + s * dx;
+  q.kaz = wg * ez + s * dz;
+}
+
+// Matching and centering; returns r2.
+inline double NeighborForces::transposed_matching_centering(const AgentAdjoint& aj, const AgentAdjoint& ai,
+                                                            PairTransposed& q) const {
+  const double dx = aj.x - ai.x, dz = aj.z - ai.z;
+  const double r2 = dx * dx + dz * dz;
   KernelWeight km;
   if (r2 < rm2_) {
     // K^T: 2 w' ((v_i - v_j) . (y_j - y_i)) d;  D^T: w (y_i - y_j).
@@ -89,7 +99,7 @@ inline PairTransposed NeighborForces::transposed_pair(const AgentAdjoint& aj, co
     q.kcx = ai.c_over_b * (k.w * ai.yx + si * gx) - aj.c_over_b * (k.w * aj.yx - sj * gx);
     q.kcz = ai.c_over_b * (k.w * ai.yz + si * gz) - aj.c_over_b * (k.w * aj.yz - sj * gz);
   }
-  return q;
+  return r2;
 }
 
 namespace {
@@ -124,17 +134,46 @@ void NeighborForces::finish_transposed(const PairTransposed& sum, Planar& kt, Pl
   dt = {kmatch_ * sum.dmx, kmatch_ * sum.dmz};
 }
 
-Planar NeighborForces::force(const AgentMotion* a, std::span<const int> nbrs, int i, Planar& offset_i,
+// Two passes over the list, so that no branch depends on whether a neighbour is within the avoidance radius
+// (about a third are, in no predictable order): matching and centering over every neighbour, moving those
+// within the avoidance radius to the front of the list as it goes, then avoidance over those. Each sum still
+// adds its nonzero terms in list order, and a term a pass skips is +0, which leaves a sum unchanged: the
+// results are bit for bit those of one pass with branches.
+Planar NeighborForces::force(const AgentMotion* a, std::span<int> nbrs, int i, Planar& offset_i,
                              double& b_i) const {
   ForwardSum sum;
-  for (int j : nbrs) sum.add(forward_pair(a[i], a[j]));
+  size_t near = 0;
+  for (int j : nbrs) {
+    PairForward q;
+    const double r2 = forward_matching_centering(a[i], a[j], q);
+    sum.add(q);
+    nbrs[near] = j;
+    near += size_t(r2 < ra2_);
+  }
+  for (size_t e = 0; e < near; ++e) {
+    PairForward q;
+    forward_avoidance(a[i], a[nbrs[e]], q);
+    sum.add(q);
+  }
   return finish_force(sum.s, offset_i, b_i);
 }
 
-void NeighborForces::transpose_apply(const AgentAdjoint* a, std::span<const int> nbrs, int j, Planar& kt,
+void NeighborForces::transpose_apply(const AgentAdjoint* a, std::span<int> nbrs, int j, Planar& kt,
                                      Planar& dt) const {
   TransposedSum sum;
-  for (int i : nbrs) sum.add(transposed_pair(a[j], a[i]));
+  size_t near = 0;
+  for (int i : nbrs) {
+    PairTransposed q;
+    const double r2 = transposed_matching_centering(a[j], a[i], q);
+    sum.add(q);
+    nbrs[near] = i;
+    near += size_t(r2 < ra2_);
+  }
+  for (size_t e = 0; e < near; ++e) {
+    PairTransposed q;
+    transposed_avoidance(a[j], a[nbrs[e]], q);
+    sum.add(q);
+  }
   finish_transposed(sum.s, kt, dt);
 }
 

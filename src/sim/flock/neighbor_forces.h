@@ -56,15 +56,21 @@ class NeighborForces {
   bool any() const { return radius_ > 0; }
   double centering_strength() const { return kc_; }
 
-  // a: all agents; nbrs: neighbours of i. Returns the force on i (N) and writes offset_i (m) and b_i.
-  Planar force(const AgentMotion* a, std::span<const int> nbrs, int i, Planar& offset_i, double& b_i) const;
+  // a: all agents; nbrs: neighbours of i, reordered (work space). Returns the force on i (N) and writes
+  // offset_i (m) and b_i.
+  Planar force(const AgentMotion* a, std::span<int> nbrs, int i, Planar& offset_i, double& b_i) const;
 
-  // a: all agents (y, offsets and c/b filled). Returns (K^T y)_j in kt and (D^T y)_j in dt.
-  void transpose_apply(const AgentAdjoint* a, std::span<const int> nbrs, int j, Planar& kt, Planar& dt) const;
+  // a: all agents (y, offsets and c/b filled); nbrs: neighbours of j, reordered (work space). Returns
+  // (K^T y)_j in kt and (D^T y)_j in dt.
+  void transpose_apply(const AgentAdjoint* a, std::span<int> nbrs, int j, Planar& kt, Planar& dt) const;
 
  private:
-  PairForward forward_pair(const AgentMotion& ai, const AgentMotion& aj) const;
-  PairTransposed transposed_pair(const AgentAdjoint& aj, const AgentAdjoint& ai) const;
+  // One pair's terms, added to q: avoidance (for a neighbour within its radius), then matching and
+  // centering (returning the pair's squared distance).
+  void forward_avoidance(const AgentMotion& ai, const AgentMotion& aj, PairForward& q) const;
+  double forward_matching_centering(const AgentMotion& ai, const AgentMotion& aj, PairForward& q) const;
+  void transposed_avoidance(const AgentAdjoint& aj, const AgentAdjoint& ai, PairTransposed& q) const;
+  double transposed_matching_centering(const AgentAdjoint& aj, const AgentAdjoint& ai, PairTransposed& q) const;
   Planar finish_force(const PairForward& sum, Planar& offset_i, double& b_i) const;
   void finish_transposed(const PairTransposed& sum, Planar& kt, Planar& dt) const;
 
