@@ -135,45 +135,44 @@ void NeighborForces::finish_transposed(const PairTransposed& sum, Planar& kt, Pl
 }
 
 // Two passes over the list, so that no branch depends on whether a neighbour is within the avoidance radius
-// (about a third are, in no predictable order): matching and centering over every neighbour, moving those
-// within the avoidance radius to the front of the list as it goes, then avoidance over those. Each sum still
-// adds its nonzero terms in list order, and a term a pass skips is +0, which leaves a sum unchanged: the
-// results are bit for bit those of one pass with branches.
+// (about a third are, in no predictable order): matching and centering over every neighbour (`every` adds
+// neighbour j's to q and returns r2), moving those within the avoidance radius to the front of the list as it
+// goes, then avoidance over those (`near`). Each sum still adds its nonzero terms in list order, and a term a
+// pass skips is +0, which leaves a sum unchanged: the results are bit for bit those of one pass with branches.
+namespace {
+template <class Pair, class Sum, class Every, class Near>
+void sum_in_two_passes(std::span<int> nbrs, double ra2, Sum& sum, Every every, Near near) {
+  size_t within = 0;
+  for (int j : nbrs) {
+    Pair q;
+    const double r2 = every(j, q);
+    sum.add(q);
+    nbrs[within] = j;
+    within += size_t(r2 < ra2);
+  }
+  for (size_t e = 0; e < within; ++e) {
+    Pair q;
+    near(nbrs[e], q);
+    sum.add(q);
+  }
+}
+}  // namespace
+
 Planar NeighborForces::force(const AgentMotion* a, std::span<int> nbrs, int i, Planar& offset_i,
                              double& b_i) const {
   ForwardSum sum;
-  size_t near = 0;
-  for (int j : nbrs) {
-    PairForward q;
-    const double r2 = forward_matching_centering(a[i], a[j], q);
-    sum.add(q);
-    nbrs[near] = j;
-    near += size_t(r2 < ra2_);
-  }
-  for (size_t e = 0; e < near; ++e) {
-    PairForward q;
-    forward_avoidance(a[i], a[nbrs[e]], q);
-    sum.add(q);
-  }
+  sum_in_two_passes<PairForward>(
+      nbrs, ra2_, sum, [&](int j, PairForward& q) { return forward_matching_centering(a[i], a[j], q); },
+      [&](int j, PairForward& q) { forward_avoidance(a[i], a[j], q); });
   return finish_force(sum.s, offset_i, b_i);
 }
 
 void NeighborForces::transpose_apply(const AgentAdjoint* a, std::span<int> nbrs, int j, Planar& kt,
                                      Planar& dt) const {
   TransposedSum sum;
-  size_t near = 0;
-  for (int i : nbrs) {
-    PairTransposed q;
-    const double r2 = transposed_matching_centering(a[j], a[i], q);
-    sum.add(q);
-    nbrs[near] = i;
-    near += size_t(r2 < ra2_);
-  }
-  for (size_t e = 0; e < near; ++e) {
-    PairTransposed q;
-    transposed_avoidance(a[j], a[nbrs[e]], q);
-    sum.add(q);
-  }
+  sum_in_two_passes<PairTransposed>(
+      nbrs, ra2_, sum, [&](int i, PairTransposed& q) { return transposed_matching_centering(a[j], a[i], q); },
+      [&](int i, PairTransposed& q) { transposed_avoidance(a[j], a[i], q); });
   finish_transposed(sum.s, kt, dt);
 }
 
