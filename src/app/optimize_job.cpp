@@ -315,6 +315,7 @@ void diagnose_run(const Scene& scene, JobResult& job, const EvaluationLog& elog,
   const Sensitivity sensitivity =
       measure_sensitivity(scene, job.time, problem.checkpoint_every(), problem.memory_budget());
   RunFacts facts = run_facts(job.status, elog.history());
+  facts.flock = scene.flock.has_value();
   facts.keyframe_objective_start = before.keyframes;
   facts.keyframe_objective_end = final_keyframes;
   facts.effort_end = effort_end;

@@ -230,12 +230,22 @@ std::string verdict_head(const Diagnosis& d, const RunFacts& facts) {
   return head;
 }
 
+// A flock's agents packed within each other's avoidance radius: the stiffness of hundreds of neighbours
+// brings the explicit step near its stability limit, and every small change moves neighbours across the
+// kernels' radii.
+constexpr const char* kPackedAgents = "agents packed within each other's avoidance radius";
+constexpr const char* kSpreadAgents =
+    "fewer agents per area (larger shapes or a larger spawn disc), the shape's coverage term so the agents "
+    "spread, finer time steps (time.substeps) or more drag (flock.drag.strength)";
+
 std::string amplifying_cause(const Sensitivity& s, const RunFacts& facts) {
   std::string cause = format("cause: the motion amplifies perturbations: the gradient per frame grows %.2gx from the "
-                             "keyframe back to frame %.0f (folds, sliding or buckling in contact after it)",
+                             "keyframe back to frame %.0f (",
                              s.growth, s.grows_from_frame) +
-                      "; change: steer over a window after that frame (controls.from_frame), keyframe earlier, or "
-                      "damp the motion (cloth.damping, cloth.air_drag, friction)";
+                      (facts.flock ? std::string(kPackedAgents) + " after it); change: " + kSpreadAgents
+                                   : std::string("folds, sliding or buckling in contact after it); change: steer over a "
+                                                 "window after that frame (controls.from_frame), keyframe earlier, or "
+                                                 "damp the motion (cloth.damping, cloth.air_drag, friction)"));
   if (facts.max_objective > 1e6 * std::max(facts.objective_start, 1e-300))
     cause += format("; trial steps reached an objective of %.2g from %.2g", facts.max_objective, facts.objective_start);
   return cause;
@@ -263,10 +273,12 @@ std::string smooth_cause(const Sensitivity& s, const RunFacts& facts) {
 std::string likely_cause(const Sensitivity& s, const RunFacts& facts) {
   if (s.noisy())
     return format("cause: the objective is noise at the start (it moves by %.2g of itself under perturbations "
-                  "of 1e-9): the start is a bifurcation, e.g. a flat sheet released in its own plane buckles "
-                  "whichever way round-off says; change: break the symmetry (a small initial velocity or offset "
-                  "out of plane) or put the keyframe later",
-                  s.relative_noise());
+                  "of 1e-9): the start is a bifurcation, ",
+                  s.relative_noise()) +
+           (facts.flock ? "e.g. agents spawned on top of each other; change: a larger spawn disc or another seed"
+                        : "e.g. a flat sheet released in its own plane buckles whichever way round-off says; change: "
+                          "break the symmetry (a small initial velocity or offset out of plane) or put the keyframe "
+                          "later");
   if (s.amplifying()) return amplifying_cause(s, facts);
   if (facts.budget && (facts.recent_improvement < 0.9 || facts.evaluations < kFewEvaluations))
     return format("cause: its budget ended it after %.0f evaluations (the objective still fell %.2gx over the "
@@ -280,10 +292,13 @@ std::string likely_cause(const Sensitivity& s, const RunFacts& facts) {
                                            d.linear_fraction, d.linear_fraction * d.reach())
                                   : std::string("does not fall as the gradient predicts even over 1e-06 of the way "
                                                 "the slope points to")) +
-           ", so the line search stalls there: contact switching, a sheet balanced where a small push tips it, or a "
-           "sheet pressed against a collider its target lies in or behind; change: move a keyframe that lies in or "
-           "behind a collider, else friction on a collider that should hold the sheet, finer time steps "
-           "(time.substeps), or a keyframe reached with less sliding contact";
+           (facts.flock ? std::string(", so the line search stalls there: ") + kPackedAgents + "; change: " +
+                              kSpreadAgents
+                        : std::string(", so the line search stalls there: contact switching, a sheet balanced "
+                                      "where a small push tips it, or a sheet pressed against a collider its target "
+                                      "lies in or behind; change: move a keyframe that lies in or behind a collider, "
+                                      "else friction on a collider that should hold the sheet, finer time steps "
+                                      "(time.substeps), or a keyframe reached with less sliding contact"));
   }
   return smooth_cause(s, facts);
 }

@@ -96,6 +96,7 @@ struct RunFacts {
   double recent_improvement = 1;     // best φ at the end over the best φ 10 % of the evaluations earlier
   int evaluations = 0;
   DescentProbe descent;              // at the best point, when the keyframes were not reached
+  bool flock = false;                // a flock's run: its causes and changes name agents, not sheets
 };
 
 struct Diagnosis {

@@ -152,5 +152,32 @@ TEST(Diagnosis, CauseNamesNoiseThenAmplificationThenBudgetThenReach) {
   EXPECT_NE(diagnose(k, s, f).line.find("out of reach"), std::string::npos);
 }
 
+// A crowd whose line search stalled among packed agents was told of sheets, colliders and friction.
+TEST(Diagnosis, AFlocksCausesNameAgentsNotSheets) {
+  Sensitivity s;
+  s.phi = 15;
+  s.phi_noise = 1e-14;
+  s.growth = s.growth_beyond_free = 1.5;
+  const auto k = one_keyframe(15, 14);
+  RunFacts f = facts(10, 9);
+  f.flock = true;
+  f.descent.linear_fraction = 1e-6;
+  f.descent.phi = 2e-3;
+  f.descent.grad_norm = 100;
+  std::string line = diagnose(k, s, f).line;
+  EXPECT_NE(line.find("the objective is rough or stiff"), std::string::npos) << line;
+  EXPECT_NE(line.find("agents packed"), std::string::npos) << line;
+  s.growth = s.growth_beyond_free = 1e12;
+  s.grows_from_frame = 6;
+  const std::string amplified = diagnose(k, s, f).line;
+  EXPECT_NE(amplified.find("amplifies perturbations"), std::string::npos) << amplified;
+  s.phi_noise = 1.8;
+  const std::string noisy = diagnose(k, s, f).line;
+  EXPECT_NE(noisy.find("agents spawned on top of each other"), std::string::npos) << noisy;
+  for (const std::string& l : {line, amplified, noisy})
+    for (const char* cloth_word : {"sheet", "collider", "cloth.", "friction"})
+      EXPECT_EQ(l.find(cloth_word), std::string::npos) << cloth_word << " in: " << l;
+}
+
 }  // namespace
 }  // namespace kf
