@@ -35,7 +35,7 @@ TEST(NeighborForces, EqualsTheSeparateTermsForwardAndTransposed) {
     const FlockState s{0, x, v, grid.lists()};
     centre.prepare(s);
     std::vector<AgentMotion> motion(p);
-    pack_motion(x, v, motion);
+    for (int i = 0; i < p; ++i) motion[i] = {x[3 * i], x[3 * i + 2], v[3 * i], v[3 * i + 2]};
     std::vector<Planar> offset(p);
     std::vector<double> b(p);
     double largest = 0;

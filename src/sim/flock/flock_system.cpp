@@ -62,6 +62,12 @@ void FlockSystem::index(const VecX& x, const VecX& v) {
   });
 }
 
+std::span<int> FlockSystem::slot_neighbors(int k) const {
+  std::vector<int>& slots = slot_scratch();
+  const int n = grid_.neighbors_of_slot(k, slots);
+  return {slots.data(), size_t(n)};
+}
+
 void FlockSystem::size_record(FlockRecord& r) const {
   const int p = spec_.agents;
   if (int(r.b.size()) != p) {
@@ -76,9 +82,7 @@ Planar FlockSystem::neighbor_force(FlockRecord& r, int k, int i) const {
     r.b[i] = 1.0;
     return Planar{};
   }
-  std::vector<int>& slots = slot_scratch();
-  const int n = grid_.neighbors_of_slot(k, slots);
-  return neighbor_forces_.force(motion_.data(), {slots.data(), size_t(n)}, k, r.offset[i], r.b[i]);
+  return neighbor_forces_.force(motion_.data(), slot_neighbors(k), k, r.offset[i], r.b[i]);
 }
 
 void FlockSystem::pack_adjoint(const FlockRecord& r, const VecX& y) {
@@ -127,10 +131,8 @@ void FlockSystem::transpose_apply(int n, const VecX& x, const VecX& v, const Vec
   kt.setZero();
   dt.setZero();
   if (neighbor_forces_.any()) {
-    std::vector<int>& slots = slot_scratch();
-    const int count = grid_.neighbors_of_slot(k, slots);
     Planar kp, dp;
-    neighbor_forces_.transpose_apply(adjoint_.data(), {slots.data(), size_t(count)}, k, kp, dp);
+    neighbor_forces_.transpose_apply(adjoint_.data(), slot_neighbors(k), k, kp, dp);
     kt = Vec3(kp.x, 0, kp.z);
     dt = Vec3(dp.x, 0, dp.z);
   }

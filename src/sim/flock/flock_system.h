@@ -16,6 +16,7 @@
 // packed in the grid's slot order.
 // Planar: the y components of x1, v1 and of every adjoint output are exactly zero (y of u is ignored).
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "scene/flock_spec.h"
@@ -67,6 +68,8 @@ class FlockSystem final : public System {
   // neighbour forces: then slot k is agent k).
   void index(const VecX& x, const VecX& v);
   int agent(int k) const { return neighbor_forces_.any() ? grid_.agent_at(k) : k; }
+  // The slots of slot k's neighbours, in this thread's work space (valid until its next call).
+  std::span<int> slot_neighbors(int k) const;
   void size_record(FlockRecord& r) const;
   // Forward neighbour pass for the agent i in slot k (motion_ packed): its force, and r's offset_i, b_i.
   Planar neighbor_force(FlockRecord& r, int k, int i) const;

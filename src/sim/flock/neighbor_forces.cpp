@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "sim/flock/avoidance_force.h"
-#include "sim/flock/parallel_agents.h"
 #include "sim/flock/smooth_kernel.h"
 
 namespace kf {
@@ -174,10 +173,6 @@ void NeighborForces::transpose_apply(const AgentAdjoint* a, std::span<int> nbrs,
       nbrs, ra2_, sum, [&](int i, PairTransposed& q) { return transposed_matching_centering(a[j], a[i], q); },
       [&](int i, PairTransposed& q) { transposed_avoidance(a[j], a[i], q); });
   finish_transposed(sum.s, kt, dt);
-}
-
-void pack_motion(const VecX& x, const VecX& v, std::vector<AgentMotion>& a) {
-  parallel_agents(int(a.size()), [&](int i) { a[i] = {x[3 * i], x[3 * i + 2], v[3 * i], v[3 * i + 2]}; });
 }
 
 }  // namespace kf

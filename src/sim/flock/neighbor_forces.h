@@ -83,7 +83,4 @@ class NeighborForces {
   double radius_ = 0;
 };
 
-// Packs x and v (3p each) into a (p entries, sized by the caller).
-void pack_motion(const VecX& x, const VecX& v, std::vector<AgentMotion>& a);
-
 }  // namespace kf
