@@ -54,9 +54,11 @@ void add_simulate_command(CLI::App& app) {
     const auto t0 = std::chrono::steady_clock::now();
     const bool ok = simulate_frames(*sys, x0, v0, scene.time, r);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (!ok)
+    if (!ok) {
+      const std::string why = sys->divergence_reason();
       throw InputError(scene.file.string() + ": the simulation diverged at step " + std::to_string(r.diverged_at) +
-                       " (reduce the time step or the stiffness)");
+                       (why.empty() ? " (reduce the time step or the stiffness)" : ": " + why));
+    }
     commit_run_dir(staged, [&](const fs::path& work) {
       prepare_run_dir(work, scene);
       save_trajectory(work / "trajectory.bin", frames_of(r, scene.time, sys->particles()));

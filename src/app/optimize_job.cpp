@@ -413,7 +413,10 @@ void check_resumed_controls(const fs::path& dir, Problem& problem, const VecX& z
   std::ostringstream largest;
   largest << std::setprecision(3) << z.cwiseAbs().maxCoeff();
   throw InputError((dir / "controls.bin").string() + ": " +
-                   (step >= 0 ? "the simulation diverges at step " + std::to_string(step)
+                   (step >= 0 ? "the simulation diverges at step " + std::to_string(step) +
+                                    (problem.system().divergence_reason().empty()
+                                         ? std::string()
+                                         : " (" + problem.system().divergence_reason() + ")")
                               : std::string("the objective is not finite")) +
                    " under these controls (largest magnitude " + largest.str() + "), so there is no run to resume "
                    "from them");

@@ -41,9 +41,9 @@ class System {
   virtual std::size_t record_bytes_estimate() const { return 6 * sizeof(double) * std::size_t(particles()); }
 
   // Advances the state of step n by one step under control force u and writes what its adjoint needs to
-  // `record`. Returns false when the result is not finite or an inner solve failed; the caller treats
-  // that as a diverged simulation. x_next and v_next arrive sized 3p. Must not allocate after the first
-  // call with the same record.
+  // `record`. Returns false when the result is not finite, an inner solve failed or the step is unstable
+  // at this state (divergence_reason says why); the caller treats that as a diverged simulation. x_next
+  // and v_next arrive sized 3p. Must not allocate after the first call with the same record.
   virtual bool step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next,
                     StepRecord& record) = 0;
 
@@ -78,6 +78,9 @@ class System {
 
   // One-line description for logs ("flock: 200 agents, grid neighbour search").
   virtual std::string describe() const = 0;
+  // Why the last step that returned false failed, with what would help, in the scene's words; empty when
+  // it only met values that are not finite.
+  virtual std::string divergence_reason() const { return {}; }
 
   // Named counters of the last forward simulation for run reports (a cape's collision contacts).
   virtual std::vector<std::pair<std::string, double>> run_stats() const { return {}; }

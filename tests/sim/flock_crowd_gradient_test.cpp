@@ -1,4 +1,4 @@
-// The flock gradient at crowd scale: 10,000 agents packed at twice the figures' density, random controls,
+// The flock gradient at crowd scale: 10,000 agents packed at the spawn's densest, random controls,
 // sampled against central finite differences at two step sizes (Release builds only: a Debug build runs
 // the ~40 rollouts too slowly).
 #include <gtest/gtest.h>
@@ -45,7 +45,9 @@ TEST(FlockCrowd, GradientAtTenThousandAgentsMatchesSampledFiniteDifferences) {
   const int p = 10000, N = 6;
   FlockSpec spec;
   spec.agents = p;
-  spec.spawn.radius = std::sqrt(p / (M_PI * 2.0));  // 2 agents per m^2: bunched, ~40 neighbours each
+  // 1 agent per m^2, as densely as the spawn lattice's 0.9 m spacing allows: ~28 neighbours each. (At 2 per
+  // m^2 the lattice holds only half of them, and the rest all start at the centre.)
+  spec.spawn.radius = std::sqrt(p / M_PI);
   spec.spawn.velocity = Vec3(0.8, 0, 0.2);
   spec.wander.correlation_steps = 10;
   FlockSystem sys(spec, 1.0 / 30, N, 11);
@@ -55,7 +57,7 @@ TEST(FlockCrowd, GradientAtTenThousandAgentsMatchesSampledFiniteDifferences) {
   std::vector<VecX> U(N);
   for (auto& u : U) u = random_planar(p, 0.5, rng);
   Rollout r;
-  ASSERT_TRUE(simulate(sys, x0, v0, U, r));
+  ASSERT_TRUE(simulate(sys, x0, v0, U, r)) << sys.divergence_reason();
 
   std::vector<int> watched;
   for (int i = 0; i < p; i += 500) watched.push_back(i);  // 20 agents spread over the crowd
@@ -115,7 +117,7 @@ TEST(FlockCrowd, GradientAtTenThousandAgentsMatchesSampledFiniteDifferences) {
   std::printf("crowd gradient: %zu samples, largest |fd| %.3g, smallest neighbour |fd| %.3g, step-size spread %.2g, "
               "worst relative error %.2g\n",
               samples.size(), largest, smallest_neighbour, spread, worst);
-  ASSERT_GT(largest, 1e-3);
+  ASSERT_GT(largest, 1e-4);  // far above phi's round-off (~1e-12 / 1e-4 in a difference quotient)
   ASSERT_GT(smallest_neighbour, 1e-9) << "a neighbour's control must reach the watched agent";
   // h and 2h differ by their O(h^2) truncation (4e-6 of the largest when this was written), which the
   // extrapolation removes; a kink or round-off would show as a larger disagreement.

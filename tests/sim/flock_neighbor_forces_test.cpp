@@ -42,13 +42,20 @@ TEST(NeighborForces, EqualsTheSeparateTermsForwardAndTransposed) {
     for (int i = 0; i < p; ++i) {
       Vec3 f_ref = Vec3::Zero();
       std::vector<int> list(grid.neighbors(i).begin(), grid.neighbors(i).end());  // the pass reorders it
-      const Planar fp = fused.force(motion.data(), list, i, offset[i], b[i]);
+      double damping = 0;
+      const Planar fp = fused.force(motion.data(), list, i, offset[i], b[i], damping);
       const Vec3 f(fp.x, 0, fp.z);
       avoid.add_force(s, i, f_ref);
       match.add_force(s, i, f_ref);
       centre.add_force(s, i, f_ref);
       largest = std::max(largest, f_ref.norm());
       EXPECT_LT((f - f_ref).norm(), 1e-12 * (1 + f_ref.norm())) << "agent " << i;
+      // Matching's own damping is -D_ii: (D^T e_i)_i with e_i agent i's x direction.
+      VecX e = VecX::Zero(3 * p);
+      e[3 * i] = 1;
+      Vec3 de = Vec3::Zero();
+      match.add_DT(s, e, i, de);
+      EXPECT_NEAR(damping, -de.x(), 1e-12 * (1 + damping)) << "agent " << i;
     }
     ASSERT_GT(largest, 0.1);
     std::vector<AgentAdjoint> adjoint(p);

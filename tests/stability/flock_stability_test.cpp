@@ -5,12 +5,16 @@
 #include "scene/scene.h"
 #include "sim/flock/flock_system.h"
 #include "stability_util.h"
+#include "../sim/random_flock.h"
 
 namespace kf {
 namespace {
 
-FlockSpec flock_spec(int agents) {
-  return *parse_scene(R"({"flock": {"agents": )" + std::to_string(agents) + R"(, "spawn": {"radius": 8}}})", "f.json").flock;
+FlockSpec flock_spec(int agents, double spawn_radius = 8) {
+  return *parse_scene(R"({"flock": {"agents": )" + std::to_string(agents) + R"(, "spawn": {"radius": )" +
+                          std::to_string(spawn_radius) + "}}}",
+                      "f.json")
+              .flock;
 }
 
 struct LastStateCost : StateCost {
@@ -74,6 +78,29 @@ TEST(FlockStability, LongHorizonStaysFiniteWithCheckpointedGradient) {
   backward(sys, r, u, cost, [&](int, const VecX& g) { finite = finite && g.allFinite(); }, dx0, dv0);
   EXPECT_TRUE(finite);
   EXPECT_TRUE(dx0.allFinite() && dv0.allFinite());
+}
+
+// 400 agents within a 1.5 m square: each feels the velocity matching of all the others (radius 3 m), so
+// the explicit step's update of its own velocity, 1 - h (c sum w + drag)/m, falls below -1 at 30 steps a
+// second. The step refuses that state and says why; ten times smaller steps take it.
+TEST(FlockStability, APackedCrowdWhoseMatchingTheStepOvershootsIsRefusedWithTheReason) {
+  const int p = 400;
+  std::mt19937_64 rng(4);
+  const VecX x = random_planar(p, 0.75, rng), v = random_planar(p, 1.0, rng), u = VecX::Zero(3 * p);
+  for (const int per_second : {30, 300}) {
+    FlockSystem sys(flock_spec(p, 20), 1.0 / per_second, 10, 5);
+    VecX x1, v1;
+    const bool taken = sys.step(0, x, v, u, x1, v1);
+    const std::string why = sys.divergence_reason();
+    if (per_second == 30) {
+      EXPECT_FALSE(taken);
+      EXPECT_NE(why.find("matching"), std::string::npos) << why;
+      EXPECT_NE(why.find("time.substeps"), std::string::npos) << why;
+    } else {
+      EXPECT_TRUE(taken) << why;
+      EXPECT_TRUE(why.empty()) << why;
+    }
+  }
 }
 
 }  // namespace

@@ -22,6 +22,7 @@ FlockSystem::FlockSystem(const FlockSpec& spec, double h, int steps, unsigned se
   }
   if (spec.drag.strength > 0) local_forces_.push_back(std::make_unique<DragForce>(spec.drag.strength));
   y_.resize(dof());
+  overshoot_.assign(spec.agents, 0.0);
   motion_.resize(spec.agents);
   adjoint_.resize(spec.agents);
 }
@@ -76,13 +77,32 @@ void FlockSystem::size_record(FlockRecord& r) const {
   }
 }
 
-Planar FlockSystem::neighbor_force(FlockRecord& r, int k, int i) const {
+Planar FlockSystem::neighbor_force(FlockRecord& r, int k, int i, double& damping) const {
+  damping = 0;
   if (!neighbor_forces_.any()) {
     r.offset[i] = Planar{};
     r.b[i] = 1.0;
     return Planar{};
   }
-  return neighbor_forces_.force(motion_.data(), slot_neighbors(k), k, r.offset[i], r.b[i]);
+  return neighbor_forces_.force(motion_.data(), slot_neighbors(k), k, r.offset[i], r.b[i], damping);
+}
+
+bool FlockSystem::stable_velocity_update(int n) {
+  const double worst = overshoot_.empty() ? 0.0 : *std::max_element(overshoot_.begin(), overshoot_.end());
+  if (worst < 2.0) return true;
+  unstable_step_ = n;
+  unstable_overshoot_ = worst;
+  return false;
+}
+
+std::string FlockSystem::divergence_reason() const {
+  if (unstable_step_ < 0) return {};
+  std::ostringstream os;
+  os.precision(3);
+  os << "at step " << unstable_step_ << " agents packed so densely that the explicit step overshoots their velocity "
+     << "matching: h (matching.strength x the summed neighbour weights + drag.strength) / mass reached "
+     << unstable_overshoot_ << " (it must stay below 2); raise time.substeps or lower flock.matching.strength";
+  return os.str();
 }
 
 void FlockSystem::pack_adjoint(const FlockRecord& r, const VecX& y) {
@@ -110,10 +130,13 @@ bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
   index(x, v);
   x_next.resize(dof());
   v_next.resize(dof());
+  const double drag = std::max(spec_.drag.strength, 0.0);
   parallel_agents(spec_.agents, [&](int k) {
     const int i = agent(k);
     Vec3 f = seg(u, i) + local_force(n, v, i);
-    const Planar fn = neighbor_force(r, k, i);
+    double damping;
+    const Planar fn = neighbor_force(r, k, i, damping);
+    overshoot_[i] = h_ * (damping + drag) / masses_[i];
     f.x() += fn.x;
     f.z() += fn.z;
     Vec3 v1 = seg(v, i) + (h_ / masses_[i]) * f;
@@ -123,7 +146,8 @@ bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
     seg(v_next, i) = v1;
     seg(x_next, i) = x1;
   });
-  return x_next.allFinite() && v_next.allFinite();
+  unstable_step_ = -1;
+  return x_next.allFinite() && v_next.allFinite() && stable_velocity_update(n);
 }
 
 void FlockSystem::transpose_apply(int n, const VecX& x, const VecX& v, const VecX& y, int k, int j, Vec3& kt,
@@ -183,7 +207,8 @@ void FlockSystem::forces(int n, const VecX& x, const VecX& v, VecX& f) {
   parallel_agents(spec_.agents, [&](int k) {
     const int i = agent(k);
     Vec3 fi = local_force(n, v, i);
-    const Planar fn = neighbor_force(scratch_, k, i);
+    double damping;
+    const Planar fn = neighbor_force(scratch_, k, i, damping);
     fi.x() += fn.x;
     fi.z() += fn.z;
     seg(f, i) = fi;
@@ -194,7 +219,10 @@ void FlockSystem::apply_KT_DT(int n, const VecX& x, const VecX& v, const VecX& y
   check_size(x, v);
   size_record(scratch_);
   index(x, v);
-  parallel_agents(spec_.agents, [&](int k) { neighbor_force(scratch_, k, agent(k)); });  // centering quantities
+  parallel_agents(spec_.agents, [&](int k) {  // centering quantities
+    double damping;
+    neighbor_force(scratch_, k, agent(k), damping);
+  });
   pack_adjoint(scratch_, y);
   KTy.resize(dof());
   DTy.resize(dof());

@@ -29,150 +29,141 @@ NeighborForces::NeighborForces(const FlockSpec& s)
   if (kc_ > 0) radius_ = std::max(radius_, s.centering.radius);
 }
 
-// d = x_i - x_j. Avoidance, for a neighbour within its radius: w g d.
-inline void NeighborForces::forward_avoidance(const AgentMotion& ai, const AgentMotion& aj, PairForward& q) const {
-  const double dx = ai.x - aj.x, dz = ai.z - aj.z;
-  const double r2 = dx * dx + dz * dz;
-  const KernelWeight k = smooth_kernel_inv(r2, inv_ra2_);
-  const double wg = k.w / std::sqrt(r2 + eps2_);
-  q.ax = wg * dx;
-  q.az = wg * dz;
+// The pair formulas on (x, z) pairs: every operation acts on both components at once, in the same order
+// and with the same operands as the scalar formula of each component, so the results are bit for bit those
+// of the scalar formulas (no fused multiply-add: the baseline instruction set has none). A pair's sums over
+// components (r^2 and dot products) add x then z, as the scalar formulas do.
+namespace {
+
+typedef double Pair2 __attribute__((vector_size(16)));
+
+inline Pair2 pair(double x, double z) { return Pair2{x, z}; }
+inline double dot2(Pair2 a, Pair2 b) {
+  const Pair2 m = a * b;
+  return m[0] + m[1];
 }
 
-// Matching and centering; returns r2. The branches skip terms out of reach (their kernel weight is zero
-// there anyway); when the list's radius is theirs, they are always taken.
+}  // namespace
+
+// Running sums of one agent's forward terms (before strengths): avoidance sum w g d in a, matching
+// w (v_j - v_i) in m and its weights in wm, centering's a_i = -sum w d in c and b_i = 1 + sum w in w (the
+// agent's own weight 1); d = x_i - x_j.
+struct NeighborForces::ForwardSum {
+  Pair2 a{0, 0}, m{0, 0}, c{0, 0};
+  double w = 1.0, wm = 0;
+};
+
+// Running sums of one agent's transposed terms (before strengths): avoidance and matching shares of K^T y,
+// matching's of D^T y, centering's of K^T y.
+struct NeighborForces::TransposedSum {
+  Pair2 ka{0, 0}, km{0, 0}, dm{0, 0}, kc{0, 0};
+};
+
+// Matching and centering of neighbour j, added to agent i's sums; returns r2. With p = x_j - x_i = -d:
+// w (v_j - v_i) is added to m, and a_i -= w d is a_i += w p. The branches skip terms out of reach (their
+// kernel weight is zero there anyway); when the list's radius is theirs, they are always taken.
 inline double NeighborForces::forward_matching_centering(const AgentMotion& ai, const AgentMotion& aj,
-                                                         PairForward& q) const {
-  const double dx = ai.x - aj.x, dz = ai.z - aj.z;
-  const double r2 = dx * dx + dz * dz;
+                                                         ForwardSum& sum) const {
+  const Pair2 p = pair(aj.x, aj.z) - pair(ai.x, ai.z);
+  const double r2 = dot2(p, p);
   double wm = 0;
-  if (r2 < rm2_) {  // matching: w (v_j - v_i)
+  if (r2 < rm2_) {
     wm = smooth_kernel_inv(r2, inv_rm2_).w;
-    q.mx = wm * (aj.vx - ai.vx);
-    q.mz = wm * (aj.vz - ai.vz);
+    sum.m += wm * (pair(aj.vx, aj.vz) - pair(ai.vx, ai.vz));
+    sum.wm += wm;
   }
-  if (r2 < rc2_) {  // centering sums: a -= w d, b += w
+  if (r2 < rc2_) {
     const double w = same_mc_ ? wm : smooth_kernel_inv(r2, inv_rc2_).w;
-    q.cx = w * dx;
-    q.cz = w * dz;
-    q.w = w;
+    sum.c += w * p;
+    sum.w += w;
   }
   return r2;
 }
 
-// d = x_j - x_i. Avoidance, for a neighbour within its radius: J(d) e with e = y_j - y_i,
-// J = w g I + 2 (w' g + w g') d d^T, g = (r2 + eps^2)^-1/2.
-inline void NeighborForces::transposed_avoidance(const AgentAdjoint& aj, const AgentAdjoint& ai,
-                                                 PairTransposed& q) const {
-  const double dx = aj.x - ai.x, dz = aj.z - ai.z;
-  const double r2 = dx * dx + dz * dz;
+// Avoidance of neighbour j within its radius: w g d, g = (r2 + eps^2)^-1/2, added as a -= w g p.
+inline void NeighborForces::forward_avoidance(const AgentMotion& ai, const AgentMotion& aj, ForwardSum& sum) const {
+  const Pair2 p = pair(aj.x, aj.z) - pair(ai.x, ai.z);
+  const double r2 = dot2(p, p);
   const KernelWeight k = smooth_kernel_inv(r2, inv_ra2_);
-  const double g = 1.0 / std::sqrt(r2 + eps2_);
-  const double ex = aj.yx - ai.yx, ez = aj.yz - ai.yz;
-  const double wg = k.w * g, s = 2.0 * (k.dw_dr2 * g - 0.5 * k.w * g * g * g) * (dx * ex + dz * ez);
-  q.kax = wg * ex + s * dx;
-  q.kaz = wg * ez + s * dz;
+  sum.a -= (k.w / std::sqrt(r2 + eps2_)) * p;
 }
 
-// Matching and centering; returns r2.
+// Matching and centering of neighbour i, added to agent j's transposed sums; returns r2. d = x_j - x_i.
 inline double NeighborForces::transposed_matching_centering(const AgentAdjoint& aj, const AgentAdjoint& ai,
-                                                            PairTransposed& q) const {
-  const double dx = aj.x - ai.x, dz = aj.z - ai.z;
-  const double r2 = dx * dx + dz * dz;
+                                                            TransposedSum& sum) const {
+  const Pair2 d = pair(aj.x, aj.z) - pair(ai.x, ai.z);
+  const double r2 = dot2(d, d);
   KernelWeight km;
   if (r2 < rm2_) {
     // K^T: 2 w' ((v_i - v_j) . (y_j - y_i)) d;  D^T: w (y_i - y_j).
     const KernelWeight k = km = smooth_kernel_inv(r2, inv_rm2_);
-    const double s = 2.0 * k.dw_dr2 * ((ai.vx - aj.vx) * (aj.yx - ai.yx) + (ai.vz - aj.vz) * (aj.yz - ai.yz));
-    q.kmx = s * dx;
-    q.kmz = s * dz;
-    q.dmx = k.w * (ai.yx - aj.yx);
-    q.dmz = k.w * (ai.yz - aj.yz);
+    const Pair2 yi = pair(ai.yx, ai.yz), yj = pair(aj.yx, aj.yz);
+    const double s = 2.0 * k.dw_dr2 * dot2(pair(ai.vx, ai.vz) - pair(aj.vx, aj.vz), yj - yi);
+    sum.km += s * d;
+    sum.dm += k.w * (yi - yj);
   }
   if (r2 < rc2_) {
     // (d f_i/d x_j)^T y_i - (d f_j/d x_i)^T y_j with g_i = -2 w' d (CenteringPair::add_KT).
     const KernelWeight k = same_mc_ ? km : smooth_kernel_inv(r2, inv_rc2_);
-    const double gx = -2.0 * k.dw_dr2 * dx, gz = -2.0 * k.dw_dr2 * dz;
-    const double si = (ai.ox - dx) * ai.yx + (ai.oz - dz) * ai.yz;
-    const double sj = (dx + aj.ox) * aj.yx + (dz + aj.oz) * aj.yz;
-    q.kcx = ai.c_over_b * (k.w * ai.yx + si * gx) - aj.c_over_b * (k.w * aj.yx - sj * gx);
-    q.kcz = ai.c_over_b * (k.w * ai.yz + si * gz) - aj.c_over_b * (k.w * aj.yz - sj * gz);
+    const Pair2 yi = pair(ai.yx, ai.yz), yj = pair(aj.yx, aj.yz);
+    const Pair2 g = -2.0 * k.dw_dr2 * d;
+    const double si = dot2(pair(ai.ox, ai.oz) - d, yi), sj = dot2(d + pair(aj.ox, aj.oz), yj);
+    sum.kc += ai.c_over_b * (k.w * yi + si * g) - aj.c_over_b * (k.w * yj - sj * g);
   }
   return r2;
 }
 
-namespace {
-
-// Running sums of one agent's pair terms. The centering sum a_i is kept in (cx, cz) with the sign of
-// PairForward (subtracted), b starts at the agent's own weight 1.
-struct ForwardSum {
-  PairForward s{0, 0, 0, 0, 0, 0, 1.0};
-  void add(const PairForward& q) {
-    s.ax += q.ax, s.az += q.az, s.mx += q.mx, s.mz += q.mz, s.cx -= q.cx, s.cz -= q.cz, s.w += q.w;
-  }
-};
-
-struct TransposedSum {
-  PairTransposed s;
-  void add(const PairTransposed& q) {
-    s.kax += q.kax, s.kaz += q.kaz, s.kmx += q.kmx, s.kmz += q.kmz;
-    s.dmx += q.dmx, s.dmz += q.dmz, s.kcx += q.kcx, s.kcz += q.kcz;
-  }
-};
-
-}  // namespace
-
-Planar NeighborForces::finish_force(const PairForward& sum, Planar& offset_i, double& b_i) const {
-  offset_i = {sum.cx / sum.w, sum.cz / sum.w};
-  b_i = sum.w;
-  return {ka_ * sum.ax + kmatch_ * sum.mx + kc_ * offset_i.x, ka_ * sum.az + kmatch_ * sum.mz + kc_ * offset_i.z};
-}
-
-void NeighborForces::finish_transposed(const PairTransposed& sum, Planar& kt, Planar& dt) const {
-  kt = {ka_ * sum.kax + kmatch_ * sum.kmx + sum.kcx, ka_ * sum.kaz + kmatch_ * sum.kmz + sum.kcz};
-  dt = {kmatch_ * sum.dmx, kmatch_ * sum.dmz};
+// Avoidance of neighbour i within its radius: J(d) e with e = y_j - y_i,
+// J = w g I + 2 (w' g + w g') d d^T, g = (r2 + eps^2)^-1/2.
+inline void NeighborForces::transposed_avoidance(const AgentAdjoint& aj, const AgentAdjoint& ai,
+                                                 TransposedSum& sum) const {
+  const Pair2 d = pair(aj.x, aj.z) - pair(ai.x, ai.z);
+  const double r2 = dot2(d, d);
+  const KernelWeight k = smooth_kernel_inv(r2, inv_ra2_);
+  const double g = 1.0 / std::sqrt(r2 + eps2_);
+  const Pair2 e = pair(aj.yx, aj.yz) - pair(ai.yx, ai.yz);
+  const double wg = k.w * g, s = 2.0 * (k.dw_dr2 * g - 0.5 * k.w * g * g * g) * dot2(d, e);
+  sum.ka += wg * e + s * d;
 }
 
 // Two passes over the list, so that no branch depends on whether a neighbour is within the avoidance radius
 // (about a third are, in no predictable order): matching and centering over every neighbour (`every` adds
-// neighbour j's to q and returns r2), moving those within the avoidance radius to the front of the list as it
-// goes, then avoidance over those (`near`). Each sum still adds its nonzero terms in list order, and a term a
-// pass skips is +0, which leaves a sum unchanged: the results are bit for bit those of one pass with branches.
+// neighbour j's terms and returns r2), moving those within the avoidance radius to the front of the list as it
+// goes, then avoidance over those (`near`). Each sum adds its terms in list order, and a term a pass skips
+// would be +0, which leaves a sum unchanged: the results are bit for bit those of one pass with branches.
 namespace {
-template <class Pair, class Sum, class Every, class Near>
-void sum_in_two_passes(std::span<int> nbrs, double ra2, Sum& sum, Every every, Near near) {
+template <class Every, class Near>
+void sum_in_two_passes(std::span<int> nbrs, double ra2, Every every, Near near) {
   size_t within = 0;
   for (int j : nbrs) {
-    Pair q;
-    const double r2 = every(j, q);
-    sum.add(q);
+    const double r2 = every(j);
     nbrs[within] = j;
     within += size_t(r2 < ra2);
   }
-  for (size_t e = 0; e < within; ++e) {
-    Pair q;
-    near(nbrs[e], q);
-    sum.add(q);
-  }
+  for (size_t e = 0; e < within; ++e) near(nbrs[e]);
 }
 }  // namespace
 
-Planar NeighborForces::force(const AgentMotion* a, std::span<int> nbrs, int i, Planar& offset_i,
-                             double& b_i) const {
+Planar NeighborForces::force(const AgentMotion* a, std::span<int> nbrs, int i, Planar& offset_i, double& b_i,
+                             double& damping_i) const {
   ForwardSum sum;
-  sum_in_two_passes<PairForward>(
-      nbrs, ra2_, sum, [&](int j, PairForward& q) { return forward_matching_centering(a[i], a[j], q); },
-      [&](int j, PairForward& q) { forward_avoidance(a[i], a[j], q); });
-  return finish_force(sum.s, offset_i, b_i);
+  sum_in_two_passes(
+      nbrs, ra2_, [&](int j) { return forward_matching_centering(a[i], a[j], sum); },
+      [&](int j) { forward_avoidance(a[i], a[j], sum); });
+  offset_i = {sum.c[0] / sum.w, sum.c[1] / sum.w};
+  b_i = sum.w;
+  damping_i = kmatch_ * sum.wm;
+  return {ka_ * sum.a[0] + kmatch_ * sum.m[0] + kc_ * offset_i.x, ka_ * sum.a[1] + kmatch_ * sum.m[1] + kc_ * offset_i.z};
 }
 
 void NeighborForces::transpose_apply(const AgentAdjoint* a, std::span<int> nbrs, int j, Planar& kt,
                                      Planar& dt) const {
   TransposedSum sum;
-  sum_in_two_passes<PairTransposed>(
-      nbrs, ra2_, sum, [&](int i, PairTransposed& q) { return transposed_matching_centering(a[j], a[i], q); },
-      [&](int i, PairTransposed& q) { transposed_avoidance(a[j], a[i], q); });
-  finish_transposed(sum.s, kt, dt);
+  sum_in_two_passes(
+      nbrs, ra2_, [&](int i) { return transposed_matching_centering(a[j], a[i], sum); },
+      [&](int i) { transposed_avoidance(a[j], a[i], sum); });
+  kt = {ka_ * sum.ka[0] + kmatch_ * sum.km[0] + sum.kc[0], ka_ * sum.ka[1] + kmatch_ * sum.km[1] + sum.kc[1]};
+  dt = {kmatch_ * sum.dm[0], kmatch_ * sum.dm[1]};
 }
 
 }  // namespace kf

@@ -35,18 +35,6 @@ struct Planar {
   double x = 0, z = 0;
 };
 
-// One pair's forward terms seen from agent i with neighbour j, before strengths: avoidance w g d, matching
-// w (v_j - v_i), centering w d (subtracted from a_i) and w (added to b_i); d = x_i - x_j.
-struct PairForward {
-  double ax = 0, az = 0, mx = 0, mz = 0, cx = 0, cz = 0, w = 0;
-};
-
-// One pair's transposed terms seen from agent j with neighbour i, as transpose_apply sums them: avoidance and
-// matching shares of K^T y before strengths, matching's of D^T y before its strength, centering's of K^T y.
-struct PairTransposed {
-  double kax = 0, kaz = 0, kmx = 0, kmz = 0, dmx = 0, dmz = 0, kcx = 0, kcz = 0;
-};
-
 class NeighborForces {
  public:
   explicit NeighborForces(const FlockSpec& spec);
@@ -57,22 +45,24 @@ class NeighborForces {
   double centering_strength() const { return kc_; }
 
   // a: all agents; nbrs: neighbours of i, reordered (work space). Returns the force on i (N) and writes
-  // offset_i (m) and b_i.
-  Planar force(const AgentMotion* a, std::span<int> nbrs, int i, Planar& offset_i, double& b_i) const;
+  // offset_i (m), b_i and damping_i = c sum_j w_ij, how strongly matching pulls i's own velocity
+  // (-D_ii, N/(m/s)).
+  Planar force(const AgentMotion* a, std::span<int> nbrs, int i, Planar& offset_i, double& b_i,
+               double& damping_i) const;
 
   // a: all agents (y, offsets and c/b filled); nbrs: neighbours of j, reordered (work space). Returns
   // (K^T y)_j in kt and (D^T y)_j in dt.
   void transpose_apply(const AgentAdjoint* a, std::span<int> nbrs, int j, Planar& kt, Planar& dt) const;
 
  private:
-  // One pair's terms, added to q: avoidance (for a neighbour within its radius), then matching and
-  // centering (returning the pair's squared distance).
-  void forward_avoidance(const AgentMotion& ai, const AgentMotion& aj, PairForward& q) const;
-  double forward_matching_centering(const AgentMotion& ai, const AgentMotion& aj, PairForward& q) const;
-  void transposed_avoidance(const AgentAdjoint& aj, const AgentAdjoint& ai, PairTransposed& q) const;
-  double transposed_matching_centering(const AgentAdjoint& aj, const AgentAdjoint& ai, PairTransposed& q) const;
-  Planar finish_force(const PairForward& sum, Planar& offset_i, double& b_i) const;
-  void finish_transposed(const PairTransposed& sum, Planar& kt, Planar& dt) const;
+  // Running sums of one agent's pair terms, and one pair's terms added to them: avoidance (for a neighbour
+  // within its radius), then matching and centering (returning the pair's squared distance).
+  struct ForwardSum;
+  struct TransposedSum;
+  void forward_avoidance(const AgentMotion& ai, const AgentMotion& aj, ForwardSum& sum) const;
+  double forward_matching_centering(const AgentMotion& ai, const AgentMotion& aj, ForwardSum& sum) const;
+  void transposed_avoidance(const AgentAdjoint& aj, const AgentAdjoint& ai, TransposedSum& sum) const;
+  double transposed_matching_centering(const AgentAdjoint& aj, const AgentAdjoint& ai, TransposedSum& sum) const;
 
   double ka_, kmatch_, kc_;           // strengths
   double ra2_, rm2_, rc2_;            // squared radii, 0 for a term that is off
