@@ -101,7 +101,7 @@ class FlockSystem final : public System {
   FlockRecord scratch_;  // forces() and apply_KT_DT
   VecX y_;  // M^-1 s in the adjoint step
   std::vector<double> overshoot_;  // per agent, the last step's h (c sum w + drag)/m (p)
-  int unstable_step_ = -1;         // the last step refused as unstable, and its largest overshoot
+  int unstable_step_ = -1;         // the last step refused as unstable (-1: none), and its largest overshoot
   double unstable_overshoot_ = 0;
 };
 
