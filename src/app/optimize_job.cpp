@@ -59,7 +59,7 @@ std::string format_record(int stage, const EvaluationRecord& r) {
   os << (stage > 0 ? "stage " + std::to_string(stage) + " " : "") << "eval " << std::setw(4) << r.evaluation
      << "  phi " << std::scientific << std::setprecision(4) << r.phi << "  |g| " << r.grad_norm;
   for (const auto& [name, value] : r.terms) os << "  " << name << " " << value;
-  os << std::fixed << std::setprecision(2) << "  " << r.seconds << " s" << (r.diverged ? "  (diverged)" : "");
+  os << std::fixed << std::setprecision(2) << "  " << r.seconds << " s" << (r.unstable ? "  (unstable)" : r.diverged ? "  (diverged)" : "");
   return os.str();
 }
 
@@ -188,6 +188,7 @@ RunFacts run_facts(const std::string& status, const std::vector<HistoryRow>& his
   const size_t earlier = history.size() - std::max<size_t>(1, history.size() / 10);
   for (size_t i = 0; i < history.size(); ++i) {
     f.max_objective = std::max(f.max_objective, history[i].rec.phi);
+    f.unstable_trials += int(history[i].rec.unstable);
     best = std::min(best, history[i].rec.phi);
     if (i < earlier) best_earlier = std::min(best_earlier, history[i].rec.phi);
   }

@@ -270,7 +270,23 @@ std::string smooth_cause(const Sensitivity& s, const RunFacts& facts) {
                 100 * effort_share);
 }
 
+// Trial steps the system refused as unstable, often enough that the search crept along their edge.
+bool unstable_edge(const RunFacts& facts) {
+  return facts.unstable_trials >= 3 && 4 * facts.unstable_trials >= facts.evaluations;
+}
+
+std::string unstable_cause(const RunFacts& facts) {
+  return format("cause: %.0f of its %.0f evaluations were trial steps whose simulation was refused as unstable ",
+                double(facts.unstable_trials), double(facts.evaluations)) +
+         (facts.flock ? "(agents packed so densely that the explicit step overshoots their velocity matching), so "
+                        "the search crept along that edge; change: finer time steps (time.substeps), a later "
+                        "keyframe so the agents need not rush, or a lower flock.matching.strength"
+                      : "(its step cannot follow the state they reach), so the search crept along that edge; change: "
+                        "finer time steps (time.substeps)");
+}
+
 std::string likely_cause(const Sensitivity& s, const RunFacts& facts) {
+  if (unstable_edge(facts)) return unstable_cause(facts);
   if (s.noisy())
     return format("cause: the objective is noise at the start (it moves by %.2g of itself under perturbations "
                   "of 1e-9): the start is a bifurcation, ",

@@ -97,6 +97,7 @@ struct RunFacts {
   int evaluations = 0;
   DescentProbe descent;              // at the best point, when the keyframes were not reached
   bool flock = false;                // a flock's run: its causes and changes name agents, not sheets
+  int unstable_trials = 0;           // evaluations whose simulation the system refused as unstable
 };
 
 struct Diagnosis {

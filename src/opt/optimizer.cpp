@@ -70,6 +70,7 @@ struct Driver {
     } else {
       phi = problem.evaluate(z, gz);
       rec.diverged = problem.last_diverged();
+      rec.unstable = rec.diverged && !problem.system().divergence_reason().empty();
       rec.terms = problem.breakdown();
       rec.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }

@@ -17,6 +17,7 @@ struct EvaluationRecord {
   double grad_norm = 0;
   double seconds = 0;  // since the start of the optimisation
   bool diverged = false;
+  bool unstable = false;  // diverged because the system refused a step as unstable (System::divergence_reason)
   std::vector<std::pair<std::string, double>> terms;
 };
 

@@ -179,5 +179,29 @@ TEST(Diagnosis, AFlocksCausesNameAgentsNotSheets) {
       EXPECT_EQ(l.find(cloth_word), std::string::npos) << cloth_word << " in: " << l;
 }
 
+// A 100,000-agent crowd's run: half its evaluations refused as unstable, the rest smooth; the budget ended
+// it. The refusals are the cause named, not a collider or the effort; a few refusals are not.
+TEST(Diagnosis, TrialsRefusedAsUnstableAreNamedWhenThereAreMany) {
+  Sensitivity s;
+  s.phi = 15;
+  s.phi_noise = 1e-14;
+  s.growth = s.growth_beyond_free = 90;
+  const auto k = one_keyframe(15, 14);
+  RunFacts f = facts(10, 9);
+  f.flock = true;
+  f.budget = true;
+  f.status = "evaluation limit reached";
+  f.evaluations = 60;
+  f.recent_improvement = 0.95;
+  f.unstable_trials = 29;
+  const std::string line = diagnose(k, s, f).line;
+  EXPECT_NE(line.find("29 of its 60 evaluations"), std::string::npos) << line;
+  EXPECT_NE(line.find("time.substeps"), std::string::npos) << line;
+  EXPECT_EQ(line.find("collider"), std::string::npos) << line;
+  f.unstable_trials = 2;
+  const std::string few = diagnose(k, s, f).line;
+  EXPECT_EQ(few.find("refused as unstable"), std::string::npos) << few;
+}
+
 }  // namespace
 }  // namespace kf
