@@ -206,6 +206,7 @@ struct JobResult {
   std::string status;
   bool interrupted = false;
   int evaluations = 0;
+  int capped_trials = 0;  // trials refused unsimulated after an unstable one (OptimizeResult::capped_trials)
   double seconds = 0;
   double memory_budget_gb = 0;  // the run's budget
   int auto_checkpoint_every = 0;  // spacing the budget asked for in the last stage (0: none)
@@ -296,6 +297,7 @@ nlohmann::json report_summary(const Scene& scene, size_t stages, bool resuming, 
           {"status", job.status},
           {"interrupted", job.interrupted},
           {"evaluations", job.evaluations},
+          {"capped_trials", job.capped_trials},
           {"wall_seconds", job.seconds},
           {"initial_objective", history.empty() ? 0.0 : history.front().rec.phi},
           {"final_objective", final_objective},
@@ -499,6 +501,7 @@ void record_stage(const OptimizeResult& res, JobResult& job) {
   job.stages.push_back(st);
   job.seconds += res.seconds;
   job.evaluations += res.evaluations;
+  job.capped_trials += res.capped_trials;
   job.status = res.status;
   job.interrupted = res.interrupted;
 }

@@ -66,7 +66,7 @@ void save_evaluations(const std::filesystem::path& path, const std::vector<Recor
     for (const auto& r : records) {
       put(out, r.phi);
       put(out, r.seconds);
-      put(out, std::uint8_t(r.diverged));
+      put(out, std::uint8_t(r.unstable ? 2 : r.diverged ? 1 : 0));
       put(out, std::uint32_t(r.terms.size()));
       for (const auto& [name, value] : r.terms) {
         put(out, std::uint32_t(name.size()));
@@ -103,6 +103,7 @@ std::vector<RecordedEvaluation> load_evaluations(const std::filesystem::path& pa
     if (!r.take(&e.phi, 8) || !r.take(&e.seconds, 8) || !r.take(&diverged, 1) || !r.take(&terms, 4))
       throw bad("truncated at evaluation " + std::to_string(k + 1));
     e.diverged = diverged != 0;
+    e.unstable = diverged == 2;
     if (terms > 10000) throw bad("evaluation " + std::to_string(k + 1) + " claims " + std::to_string(terms) + " terms");
     for (std::uint32_t t = 0; t < terms; ++t) {
       std::uint32_t len = 0;

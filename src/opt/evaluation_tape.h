@@ -22,6 +22,7 @@ struct RecordedEvaluation {
   VecX z, g;
   double phi = 0, seconds = 0;
   bool diverged = false;
+  bool unstable = false;  // diverged because the system refused a step as unstable (stored as diverged = 2)
   std::vector<std::pair<std::string, double>> terms;
 };
 

@@ -27,6 +27,11 @@ struct Driver {
   bool have_first = false;
   double first_phi = 0;
   VecX first_g;
+  // After a trial the system refused as unstable (a flock packed past what its step can follow), a trial
+  // farther than `reach` from the best point is refused as well, without simulating it: L-BFGS's full step
+  // keeps asking for such a state, and each would cost most of a forward pass and one of the evaluations.
+  // reach is half the refused trial's distance, and doubles when an accepted step comes near it.
+  double reach = std::numeric_limits<double>::infinity();
 
   double operator()(const std::vector<double>& x, std::vector<double>& grad) {
     const Eigen::Map<const VecX> y(x.data(), Eigen::Index(x.size()));
@@ -39,7 +44,13 @@ struct Driver {
         return first_phi;
       }
     }
-    const double phi = evaluate(grad.empty() ? nullptr : &g);
+    double phi;
+    if (result.evaluations > 0 && (z - result.z).norm() > reach) {
+      ++result.capped_trials;
+      phi = problem.refuse(z, grad.empty() ? nullptr : &g);
+    } else {
+      phi = evaluate(grad.empty() ? nullptr : &g);
+    }
     if (!grad.empty()) Eigen::Map<VecX>(grad.data(), g.size()) = scale * g;
     return phi;
   }
@@ -62,6 +73,7 @@ struct Driver {
       phi = replayed->phi;
       *gz = replayed->g;
       rec.diverged = replayed->diverged;
+      rec.unstable = replayed->unstable;
       rec.terms = replayed->terms;
       rec.seconds = replayed->seconds;
       // Later evaluations count their seconds on from the recorded ones.
@@ -74,11 +86,14 @@ struct Driver {
       rec.terms = problem.breakdown();
       rec.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
-    if (tape && gz) tape->record({z, *gz, phi, rec.seconds, rec.diverged, rec.terms});
+    if (tape && gz) tape->record({z, *gz, phi, rec.seconds, rec.diverged, rec.unstable, rec.terms});
     rec.evaluation = ++result.evaluations;
     rec.phi = phi;
     rec.grad_norm = gz ? gz->norm() : 0;
+    const double step = result.evaluations > 1 ? (z - result.z).norm() : 0.0;
+    if (rec.unstable) reach = 0.5 * step;
     if (!rec.diverged && phi < result.phi) {
+      if (step > 0.5 * reach) reach *= 2;
       result.phi = phi;
       result.z = z;
     }
@@ -141,7 +156,8 @@ OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX&
       }
       nlopt::opt opt(nlopt::LD_LBFGS, n);
       opt.set_min_objective(&Driver::thunk, &d);
-      opt.set_maxeval(spec.max_evaluations);
+      // Trials refused unsimulated count for NLopt, not for the limit: it stops at the evaluation after it.
+      opt.set_maxeval(4 * spec.max_evaluations);
       d.max_evaluations = spec.max_evaluations;
       if (spec.ftol_rel > 0) opt.set_ftol_rel(spec.ftol_rel);
       if (spec.max_seconds > 0) opt.set_maxtime(spec.max_seconds);

@@ -28,6 +28,7 @@ struct OptimizeResult {
   double seconds = 0;
   std::string status;   // why it stopped
   bool interrupted = false;
+  int capped_trials = 0;  // trials refused unsimulated as farther than the reach left by an unstable one
   std::vector<EvaluationRecord> history;
 };
 

@@ -33,6 +33,12 @@ class Problem : public StateCost {
   // away from the last good point (so a line search backs off) and never NaN.
   double evaluate(const VecX& z, VecX* grad);
   bool last_diverged() const { return diverged_; }
+  // The value (and gradient) evaluate gives a point that diverged, without simulating z: for a trial the
+  // optimiser already knows to refuse. Counts as a diverged evaluation.
+  double refuse(const VecX& z, VecX* grad) {
+    diverged_ = true;
+    return diverged_objective(z, grad);
+  }
 
   // Adjoint checkpointing (scene key optimizer.checkpoint_every): evaluations with a gradient keep
   // every k-th state and recompute the others in the backward pass; 0 keeps every state. The gradient

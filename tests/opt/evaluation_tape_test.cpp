@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 namespace kf {
 namespace {
 
@@ -41,6 +43,22 @@ TEST(EvaluationTape, ARunThatFitsIsRecordedWhole) {
   tape.record(evaluation_of(n, 10));
   EXPECT_FALSE(tape.complete());
   EXPECT_TRUE(tape.records().empty());
+}
+
+// A diverged evaluation keeps whether the system refused it as unstable, so a resumed run's optimiser
+// refuses the same later trials unsimulated as the first run did.
+TEST(EvaluationTape, UnstableEvaluationsRoundTrip) {
+  std::vector<RecordedEvaluation> records = {evaluation_of(3, 1.0), evaluation_of(3, 2.0), evaluation_of(3, 3.0)};
+  records[1].diverged = true;
+  records[2].diverged = records[2].unstable = true;
+  const auto path = std::filesystem::temp_directory_path() / "kf_tape_unstable.bin";
+  save_evaluations(path, records);
+  const auto back = load_evaluations(path);
+  std::filesystem::remove(path);
+  ASSERT_EQ(back.size(), 3u);
+  EXPECT_FALSE(back[0].diverged || back[0].unstable);
+  EXPECT_TRUE(back[1].diverged && !back[1].unstable);
+  EXPECT_TRUE(back[2].diverged && back[2].unstable);
 }
 
 }  // namespace

@@ -297,6 +297,48 @@ TEST(Optimizer, RecoversFromDivergedTrialSteps) {
   EXPECT_TRUE(std::isfinite(r.phi));
   EXPECT_GT(diverged, 0) << "no trial step diverged: the test does not exercise recovery";
   EXPECT_LT(r.phi, 0.5 * phi0) << r.status;
+  EXPECT_EQ(r.capped_trials, 0) << "a trial that only diverged must not limit the reach of later ones";
+}
+
+// A tighter limit, once said to be an instability and once only a divergence. As an instability, later
+// trials farther from the best point than half a refused one's distance are refused without simulating
+// them: the run gets as far with fewer simulations. Every evaluation in its history was simulated; the
+// capped trials are counted apart.
+TEST(Optimizer, TrialsPastAnUnstableOnesReachAreRefusedWithoutSimulating) {
+  Scene scene = toy_scene("per_frame", 2);
+  scene.controls.alpha = 1e-6;
+  for (auto& o : scene.objectives) o.weight *= 1e4;
+  double peak = 0;
+  {
+    test::ToySystem free_sys(4, scene.time.h());
+    Problem free_problem(scene, scene.time, free_sys);
+    OptimizerSpec spec;
+    spec.max_evaluations = 150;
+    peak = minimize(free_problem, spec, free_problem.initial_guess()).z.cwiseAbs().maxCoeff();
+  }
+  OptimizerSpec spec;
+  spec.max_evaluations = 150;
+  spec.first_step = 0;
+  OptimizeResult runs[2];
+  int unstable = 0;
+  double phi0 = 0;
+  for (const bool is_unstable : {false, true}) {
+    test::ToySystem sys(4, scene.time.h(), 1.1 * peak, is_unstable);
+    Problem problem(scene, scene.time, sys);
+    phi0 = problem.evaluate(problem.initial_guess(), nullptr);
+    runs[is_unstable] = minimize(problem, spec, problem.initial_guess(),
+                                 [&](const EvaluationRecord& e) { unstable += e.unstable; });
+  }
+  const OptimizeResult &plain = runs[0], &capped = runs[1];
+  std::printf("unstable trials %d, capped %d; evaluations %d against %d; phi %.6g against %.6g (from %.6g)\n",
+              unstable, capped.capped_trials, capped.evaluations, plain.evaluations, capped.phi, plain.phi, phi0);
+  EXPECT_GT(unstable, 0) << "no trial was refused as unstable: the test does not exercise the reach";
+  EXPECT_GT(capped.capped_trials, 0);
+  EXPECT_EQ(plain.capped_trials, 0);
+  EXPECT_EQ(int(capped.history.size()), capped.evaluations);
+  EXPECT_LT(capped.evaluations, plain.evaluations);
+  EXPECT_LE(capped.phi, 1.01 * plain.phi) << capped.status;
+  EXPECT_LT(capped.phi, 0.05 * phi0) << capped.status;
 }
 
 }  // namespace

@@ -1,14 +1,16 @@
 #pragma once
 // A small explicit particle system for testing the optimisation layer on its own: particles joined in a
 // chain by linear springs with drag. Its step "diverges" (returns false) when a control force exceeds a limit,
-// so the optimiser's recovery from a blown-up trial step can be tested.
+// so the optimiser's recovery from a blown-up trial step can be tested; with `limit_is_unstable` it says the
+// step was refused as unstable (divergence_reason), as a flock packed past its step's limit does.
 #include "sim/system.h"
 
 namespace kf::test {
 
 class ToySystem : public System {
  public:
-  ToySystem(int p, double h, double control_limit = 1e300) : p_(p), h_(h), limit_(control_limit), m_(VecX::Constant(p, 1.5)) {}
+  ToySystem(int p, double h, double control_limit = 1e300, bool limit_is_unstable = false)
+      : p_(p), h_(h), limit_(control_limit), limit_is_unstable_(limit_is_unstable), m_(VecX::Constant(p, 1.5)) {}
   int particles() const override { return p_; }
   double h() const override { return h_; }
   const VecX& masses() const override { return m_; }
@@ -33,7 +35,11 @@ class ToySystem : public System {
     force(x, v, f_);
     for (int i = 0; i < p_; ++i) v1.segment<3>(3 * i) = v.segment<3>(3 * i) + h_ / m_[i] * (f_.segment<3>(3 * i) + u.segment<3>(3 * i));
     x1 = x + h_ * v1;
-    return v1.allFinite() && u.cwiseAbs().maxCoeff() < limit_;
+    refused_ = !(u.cwiseAbs().maxCoeff() < limit_);
+    return v1.allFinite() && !refused_;
+  }
+  std::string divergence_reason() const override {
+    return limit_is_unstable_ && refused_ ? "a control force past the toy's limit" : "";
   }
   void step_adjoint(int, const VecX&, const VecX&, const VecX&, const StepRecord&, const VecX& xhat1,
                     const VecX& vhat1, VecX& xhat, VecX& vhat, VecX& uhat) override {
@@ -56,6 +62,7 @@ class ToySystem : public System {
  private:
   int p_;
   double h_, limit_, k_ = 4.0, c_ = 0.3;
+  bool limit_is_unstable_, refused_ = false;
   VecX m_;
   mutable VecX f_;
 };
