@@ -265,20 +265,27 @@ TEST(Optimizer, AStopAskedForDuringTheLastEvaluationIsAnInterruption) {
   EXPECT_EQ(whole.status, "evaluation limit reached");
 }
 
-TEST(Optimizer, RecoversFromDivergedTrialSteps) {
-  // Controls above a limit blow the toy system up. The limit sits above the optimum's largest force,
-  // so the optimum is reachable, but the line search's long trial steps cross it.
+// The toy chain with heavy keyframes and cheap effort, and the largest control force of its optimum
+// without a limit: limits above it leave the optimum reachable while the line search's long steps cross them.
+Scene heavy_toy_scene() {
   Scene scene = toy_scene("per_frame", 2);
   scene.controls.alpha = 1e-6;
   for (auto& o : scene.objectives) o.weight *= 1e4;
-  double peak = 0;
-  {
-    test::ToySystem free_sys(4, scene.time.h());
-    Problem free_problem(scene, scene.time, free_sys);
-    OptimizerSpec spec;
-    spec.max_evaluations = 150;
-    peak = minimize(free_problem, spec, free_problem.initial_guess()).z.cwiseAbs().maxCoeff();
-  }
+  return scene;
+}
+double free_optimum_peak(const Scene& scene) {
+  test::ToySystem free_sys(4, scene.time.h());
+  Problem free_problem(scene, scene.time, free_sys);
+  OptimizerSpec spec;
+  spec.max_evaluations = 150;
+  return minimize(free_problem, spec, free_problem.initial_guess()).z.cwiseAbs().maxCoeff();
+}
+
+TEST(Optimizer, RecoversFromDivergedTrialSteps) {
+  // Controls above a limit blow the toy system up. The limit sits above the optimum's largest force,
+  // so the optimum is reachable, but the line search's long trial steps cross it.
+  const Scene scene = heavy_toy_scene();
+  const double peak = free_optimum_peak(scene);
   test::ToySystem sys(4, scene.time.h(), 1.5 * peak);
   Problem problem(scene, scene.time, sys);
   VecX big = VecX::Constant(problem.size(), 10 * peak), g(problem.size());
@@ -305,17 +312,8 @@ TEST(Optimizer, RecoversFromDivergedTrialSteps) {
 // them: the run gets as far with fewer simulations. Every evaluation in its history was simulated; the
 // capped trials are counted apart.
 TEST(Optimizer, TrialsPastAnUnstableOnesReachAreRefusedWithoutSimulating) {
-  Scene scene = toy_scene("per_frame", 2);
-  scene.controls.alpha = 1e-6;
-  for (auto& o : scene.objectives) o.weight *= 1e4;
-  double peak = 0;
-  {
-    test::ToySystem free_sys(4, scene.time.h());
-    Problem free_problem(scene, scene.time, free_sys);
-    OptimizerSpec spec;
-    spec.max_evaluations = 150;
-    peak = minimize(free_problem, spec, free_problem.initial_guess()).z.cwiseAbs().maxCoeff();
-  }
+  const Scene scene = heavy_toy_scene();
+  const double peak = free_optimum_peak(scene);
   OptimizerSpec spec;
   spec.max_evaluations = 150;
   spec.first_step = 0;
