@@ -59,7 +59,8 @@ std::string format_record(int stage, const EvaluationRecord& r) {
   os << (stage > 0 ? "stage " + std::to_string(stage) + " " : "") << "eval " << std::setw(4) << r.evaluation
      << "  phi " << std::scientific << std::setprecision(4) << r.phi << "  |g| " << r.grad_norm;
   for (const auto& [name, value] : r.terms) os << "  " << name << " " << value;
-  os << std::fixed << std::setprecision(2) << "  " << r.seconds << " s" << (r.unstable ? "  (unstable)" : r.diverged ? "  (diverged)" : "");
+  os << std::fixed << std::setprecision(2) << "  " << r.seconds << " s"
+     << (r.unstable ? "  (unstable)" : r.diverged ? "  (diverged)" : "");
   return os.str();
 }
 
@@ -415,11 +416,10 @@ void check_resumed_controls(const fs::path& dir, Problem& problem, const VecX& z
   const int step = problem.rollout().diverged_at;
   std::ostringstream largest;
   largest << std::setprecision(3) << z.cwiseAbs().maxCoeff();
+  const std::string why = problem.system().divergence_reason();
   throw InputError((dir / "controls.bin").string() + ": " +
                    (step >= 0 ? "the simulation diverges at step " + std::to_string(step) +
-                                    (problem.system().divergence_reason().empty()
-                                         ? std::string()
-                                         : " (" + problem.system().divergence_reason() + ")")
+                                    (why.empty() ? std::string() : " (" + why + ")")
                               : std::string("the objective is not finite")) +
                    " under these controls (largest magnitude " + largest.str() + "), so there is no run to resume "
                    "from them");

@@ -91,6 +91,15 @@ RunFacts facts(double start, double end, const std::string& status = "converged"
   return f;
 }
 
+// A start that is not noise (phi 15, round-off-level noise) whose gradient grows `growth` times.
+Sensitivity quiet_start(double growth) {
+  Sensitivity s;
+  s.phi = 15;
+  s.phi_noise = 1e-14;
+  s.growth = s.growth_beyond_free = growth;
+  return s;
+}
+
 TEST(Diagnosis, OutcomeFollowsProgressAndDistance) {
   const Sensitivity smooth;
   Diagnosis d = diagnose(one_keyframe(15, 0.5), smooth, facts(10, 0.01, "evaluation limit reached"));
@@ -154,10 +163,7 @@ TEST(Diagnosis, CauseNamesNoiseThenAmplificationThenBudgetThenReach) {
 
 // A crowd whose line search stalled among packed agents was told of sheets, colliders and friction.
 TEST(Diagnosis, AFlocksCausesNameAgentsNotSheets) {
-  Sensitivity s;
-  s.phi = 15;
-  s.phi_noise = 1e-14;
-  s.growth = s.growth_beyond_free = 1.5;
+  Sensitivity s = quiet_start(1.5);
   const auto k = one_keyframe(15, 14);
   RunFacts f = facts(10, 9);
   f.flock = true;
@@ -182,15 +188,10 @@ TEST(Diagnosis, AFlocksCausesNameAgentsNotSheets) {
 // A 100,000-agent crowd's run: half its evaluations refused as unstable, the rest smooth; the budget ended
 // it. The refusals are the cause named, not a collider or the effort; a few refusals are not.
 TEST(Diagnosis, TrialsRefusedAsUnstableAreNamedWhenThereAreMany) {
-  Sensitivity s;
-  s.phi = 15;
-  s.phi_noise = 1e-14;
-  s.growth = s.growth_beyond_free = 90;
+  const Sensitivity s = quiet_start(90);
   const auto k = one_keyframe(15, 14);
-  RunFacts f = facts(10, 9);
+  RunFacts f = facts(10, 9, "evaluation limit reached");
   f.flock = true;
-  f.budget = true;
-  f.status = "evaluation limit reached";
   f.evaluations = 60;
   f.recent_improvement = 0.95;
   f.unstable_trials = 29;

@@ -100,7 +100,8 @@ std::string FlockSystem::divergence_reason() const {
   std::ostringstream os;
   os.precision(3);
   os << "agents packed so densely that the explicit step overshoots their velocity matching: h (matching.strength "
-     << "x the summed neighbour weights + drag.strength) / mass reached " << unstable_overshoot_ << " (it must stay below 2); raise time.substeps or lower flock.matching.strength";
+     << "x the summed neighbour weights + drag.strength) / mass reached " << unstable_overshoot_
+     << " (it must stay below 2); raise time.substeps or lower flock.matching.strength";
   return os.str();
 }
 

@@ -153,7 +153,8 @@ Planar NeighborForces::force(const AgentMotion* a, std::span<int> nbrs, int i, P
   offset_i = {sum.c[0] / sum.w, sum.c[1] / sum.w};
   b_i = sum.w;
   damping_i = kmatch_ * sum.wm;
-  return {ka_ * sum.a[0] + kmatch_ * sum.m[0] + kc_ * offset_i.x, ka_ * sum.a[1] + kmatch_ * sum.m[1] + kc_ * offset_i.z};
+  return {ka_ * sum.a[0] + kmatch_ * sum.m[0] + kc_ * offset_i.x,
+          ka_ * sum.a[1] + kmatch_ * sum.m[1] + kc_ * offset_i.z};
 }
 
 void NeighborForces::transpose_apply(const AgentAdjoint* a, std::span<int> nbrs, int j, Planar& kt,
