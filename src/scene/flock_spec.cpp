@@ -46,6 +46,7 @@ FlockSpec parse_flock_spec(Block& b) {
   FlockSpec s;
   s.agents = b.integer("agents", s.agents, 1, 1'000'000);
   s.mass = b.number("mass", s.mass, 1e-6, 1e6);
+  s.implicit_damping = b.string("step", "explicit", {"explicit", "implicit_damping"}) == "implicit_damping";
   // Forces first: the spawn check needs the avoidance radius.
   s.avoidance = parse_neighbour_force(b.child("avoidance"), s.avoidance);
   s.matching = parse_neighbour_force(b.child("matching"), s.matching);

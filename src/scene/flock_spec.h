@@ -36,6 +36,11 @@ struct FlockSpec {
     double strength = 0.2;  // N/(m/s)
   } drag;
 
+  // How a step takes an agent's own-velocity damping (matching's pull toward its neighbours' velocities and
+  // drag): explicitly, as paper eq. 1 does (the default), or at the end of the step, which no packing can
+  // make overshoot (FlockSystem explains both).
+  bool implicit_damping = false;
+
   // Agents never start closer than this (m): 0.6 x the avoidance radius.
   double min_spawn_distance() const { return 0.6 * avoidance.radius; }
 };

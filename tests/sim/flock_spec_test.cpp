@@ -37,7 +37,7 @@ TEST(FlockSpec, ReadsEveryKey) {
       "spawn": {"center": [1, 0, -2], "radius": 6, "velocity": [0.5, 0, 0]},
       "avoidance": {"strength": 3, "radius": 1}, "matching": {"strength": 0, "radius": 2},
       "centering": {"strength": 0.5, "radius": 4}, "wander": {"strength": 0.1, "correlation_steps": 10},
-      "drag": {"strength": 0.3}}})",
+      "drag": {"strength": 0.3}, "step": "implicit_damping"}})",
                               "s.json");
   const FlockSpec& f = *s.flock;
   EXPECT_EQ(f.agents, 50);
@@ -49,8 +49,11 @@ TEST(FlockSpec, ReadsEveryKey) {
   EXPECT_EQ(f.centering.radius, 4);
   EXPECT_EQ(f.wander.correlation_steps, 10);
   EXPECT_EQ(f.drag.strength, 0.3);
+  EXPECT_TRUE(f.implicit_damping);
   EXPECT_EQ(make_system(s)->describe(),
-            "flock: 50 agents, mass 2 kg, forces: avoidance, centering, wander, drag; grid neighbour search, radius 4 m");
+            "flock: 50 agents, mass 2 kg, forces: avoidance, centering, wander, drag; grid neighbour search, radius 4 m; "
+            "own-velocity damping implicit");
+  EXPECT_FALSE(parse_scene(R"({"flock": {}})", "s.json").flock->implicit_damping);
 }
 
 TEST(FlockSpec, RejectsMalformedBlocks) {
@@ -65,6 +68,9 @@ TEST(FlockSpec, RejectsMalformedBlocks) {
   EXPECT_EQ(error_of(R"({"wander": {"correlation_steps": 2.5}})"),
             "s.json: /flock/wander/correlation_steps: expected an integer, got number 2.5");
   EXPECT_EQ(error_of(R"({"drag": 3})"), "s.json: /flock/drag: expected an object, got number 3");
+  const std::string step = error_of(R"({"step": "implicit"})");
+  EXPECT_EQ(step.rfind("s.json: /flock/step: ", 0), 0u) << step;
+  EXPECT_NE(step.find("implicit_damping"), std::string::npos) << step;
   EXPECT_EQ(error_of(R"({"speed": 3})"),
             "s.json: /flock/speed: unknown key (check its spelling; see README 'Scene files')");
   EXPECT_EQ(error_of(R"({"spawn": {"center": [0, 1, 0]}})"),

@@ -66,9 +66,11 @@ TEST(FlockSystem, StepReportsNonFiniteResults) {
   EXPECT_FALSE(sys.step(0, x, v, u, x1, v1));
 }
 
-TEST(FlockSystem, StepAdjointMatchesFiniteDifferencesOfOneStep) {
-  const int p = 20;
-  FlockSystem sys(small_flock(p), 1.0 / 30, 10, 4);
+// One step's adjoint against central differences of J = a . x1 + b . v1 at a random state with a coincident
+// pair, for every entry of xhat, vhat and uhat.
+void check_one_step_adjoint(const FlockSpec& spec) {
+  const int p = spec.agents;
+  FlockSystem sys(spec, 1.0 / 30, 10, 4);
   std::mt19937_64 rng(3);
   VecX x, v;
   sys.initial_state(x, v);
@@ -105,6 +107,21 @@ TEST(FlockSystem, StepAdjointMatchesFiniteDifferencesOfOneStep) {
   EXPECT_LT(max_relative_error(uhat, fu, 1e-6), 1e-6);
 }
 
+TEST(FlockSystem, StepAdjointMatchesFiniteDifferencesOfOneStep) { check_one_step_adjoint(small_flock(20)); }
+
+// Matching strong enough that the damping factor a_i = h (c S_i + drag)/m_i passes 1 for most agents, so
+// the implicit step's division by 1 + a_i and its dependence on positions through S_i both weigh.
+FlockSpec strongly_damped_flock(int agents) {
+  FlockSpec s = small_flock(agents);
+  s.matching.strength = 60;
+  s.implicit_damping = true;
+  return s;
+}
+
+TEST(FlockSystem, ImplicitDampingStepAdjointMatchesFiniteDifferencesOfOneStep) {
+  check_one_step_adjoint(strongly_damped_flock(20));
+}
+
 // phi = 1/2 |x_N - target|^2 + 1/4 |v_N|^2 + 1/2 |x_30 - mid|^2 (a mid-way keyframe).
 class TestCost final : public StateCost {
  public:
@@ -125,9 +142,12 @@ class TestCost final : public StateCost {
   VecX target_, mid_;
 };
 
-TEST(FlockSystem, RolloutGradientMatchesFiniteDifferences) {
-  const int p = 20, N = 60;
-  FlockSystem sys(small_flock(p), 1.0 / 30, N, 8);
+// The gradient of a mid-way and an end keyframe through a 60-step rollout under random controls, entry by
+// entry at the start, around the keyframe and at the end, and along random directions, against central
+// differences.
+void check_rollout_gradient(const FlockSpec& spec) {
+  const int p = spec.agents, N = 60;
+  FlockSystem sys(spec, 1.0 / 30, N, 8);
   std::mt19937_64 rng(21);
   VecX x0, v0;
   sys.initial_state(x0, v0);
@@ -195,14 +215,20 @@ TEST(FlockSystem, RolloutGradientMatchesFiniteDifferences) {
     ASSERT_GT(std::abs(fd_delta), 1e-3);
     rel_dir = std::max(rel_dir, std::abs(g_delta - fd_delta) / std::abs(fd_delta));
   }
-  RecordProperty("relative_error_inf_norm", std::to_string(rel_inf));
-  RecordProperty("relative_error_per_entry_floor_1e-3", std::to_string(rel_floor));
+  ::testing::Test::RecordProperty("relative_error_inf_norm", std::to_string(rel_inf));
+  ::testing::Test::RecordProperty("relative_error_per_entry_floor_1e-3", std::to_string(rel_floor));
   std::printf("rollout gradient: phi %.6g, max |grad| %.3g, max|a-fd|/max|fd| %.3g, per-entry (floor 1e-3 max) %.3g, "
               "directional %.3g\n",
               phi0, fd.cwiseAbs().maxCoeff(), rel_inf, rel_floor, rel_dir);
   EXPECT_LT(rel_inf, 1e-6);
   EXPECT_LT(rel_floor, 1e-6);
   EXPECT_LT(rel_dir, 1e-6);
+}
+
+TEST(FlockSystem, RolloutGradientMatchesFiniteDifferences) { check_rollout_gradient(small_flock(20)); }
+
+TEST(FlockSystem, ImplicitDampingRolloutGradientMatchesFiniteDifferences) {
+  check_rollout_gradient(strongly_damped_flock(20));
 }
 
 TEST(FlockSystem, BitIdenticalForOneAndTwoThreads) {

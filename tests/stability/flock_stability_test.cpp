@@ -103,5 +103,33 @@ TEST(FlockStability, APackedCrowdWhoseMatchingTheStepOvershootsIsRefusedWithTheR
   }
 }
 
+// The same packed crowd with its own-velocity damping taken implicitly: the step is taken at 30 steps a second
+// and, held packed for a second, relative velocities decay instead of growing (the explicit step, allowed to
+// go on, multiplies them by |1 - a| > 1 each step). Matching and drag alone act, so nothing but damping
+// changes the velocities.
+TEST(FlockStability, ImplicitDampingTakesThePackedCrowdAndItsRelativeVelocitiesDecay) {
+  const int p = 400;
+  std::mt19937_64 rng(4);
+  const VecX x = random_planar(p, 0.75, rng), v = random_planar(p, 1.0, rng), u = VecX::Zero(3 * p);
+  FlockSpec spec = flock_spec(p, 20);
+  spec.avoidance.strength = spec.centering.strength = spec.wander.strength = 0;
+  spec.implicit_damping = true;
+  FlockSystem sys(spec, 1.0 / 30, 30, 5);
+  auto spread = [&](const VecX& vv) {  // largest deviation from the mean velocity (m/s)
+    Vec3 mean = Vec3::Zero();
+    for (int i = 0; i < p; ++i) mean += seg(vv, i) / p;
+    double worst = 0;
+    for (int i = 0; i < p; ++i) worst = std::max(worst, (seg(vv, i) - mean).norm());
+    return worst;
+  };
+  VecX v_now = v, x1, v1;
+  for (int n = 0; n < 30; ++n) {  // positions held, so the packing and its damping stay as they are
+    ASSERT_TRUE(sys.step(n, x, v_now, u, x1, v1)) << sys.divergence_reason();
+    EXPECT_TRUE(sys.divergence_reason().empty());
+    v_now = v1;
+  }
+  EXPECT_LT(spread(v_now), 0.1 * spread(v));
+}
+
 }  // namespace
 }  // namespace kf

@@ -23,12 +23,13 @@ FlockSystem::FlockSystem(const FlockSpec& spec, double h, int steps, unsigned se
   if (spec.drag.strength > 0) local_forces_.push_back(std::make_unique<DragForce>(spec.drag.strength));
   y_.resize(dof());
   overshoot_.assign(spec.agents, 0.0);
+  if (spec.implicit_damping) q_.assign(spec.agents, 0.0);
   motion_.resize(spec.agents);
   adjoint_.resize(spec.agents);
 }
 
 std::size_t FlockSystem::record_bytes_estimate() const {
-  return (sizeof(Planar) + sizeof(double)) * std::size_t(spec_.agents);
+  return (sizeof(Planar) + sizeof(double)) * std::size_t(spec_.agents) * (spec_.implicit_damping ? 2 : 1);
 }
 
 void FlockSystem::initial_state(VecX& x, VecX& v) const {
@@ -75,6 +76,10 @@ void FlockSystem::size_record(FlockRecord& r) const {
     r.offset.resize(p);
     r.b.resize(p);
   }
+  if (spec_.implicit_damping && int(r.divisor.size()) != p) {
+    r.force.resize(p);
+    r.divisor.resize(p);
+  }
 }
 
 Planar FlockSystem::neighbor_force(FlockRecord& r, int k, int i, double& damping) const {
@@ -101,17 +106,36 @@ std::string FlockSystem::divergence_reason() const {
   os.precision(3);
   os << "agents packed so densely that the explicit step overshoots their velocity matching: h (matching.strength "
      << "x the summed neighbour weights + drag.strength) / mass reached " << unstable_overshoot_
-     << " (it must stay below 2); raise time.substeps or lower flock.matching.strength";
+     << " (it must stay below 2); set flock.step to \"implicit_damping\", raise time.substeps or lower "
+     << "flock.matching.strength";
   return os.str();
 }
 
-void FlockSystem::pack_adjoint(const FlockRecord& r, const VecX& y) {
+void FlockSystem::pack_adjoint(const FlockRecord& r, const VecX& y, const std::vector<double>* q) {
   if (!neighbor_forces_.any()) return;
   const double c = neighbor_forces_.centering_strength();
   parallel_agents(spec_.agents, [&](int k) {
     const int i = grid_.agent_at(k);
     const AgentMotion& m = motion_[k];
-    adjoint_[k] = {m.x, m.z, m.vx, m.vz, y[3 * i], y[3 * i + 2], r.offset[i].x, r.offset[i].z, c / r.b[i]};
+    adjoint_[k] = {m.x,          m.z,           m.vx,          m.vz,       y[3 * i], y[3 * i + 2],
+                   r.offset[i].x, r.offset[i].z, c / r.b[i], q ? (*q)[i] : 0.0};
+  });
+}
+
+void FlockSystem::adjoint_weights(const FlockRecord& r, const VecX& xhat1, const VecX& vhat1) {
+  const double c = spec_.matching.strength;
+  // The step writes y = 0 whatever its inputs, so the y parts of xhat1 and vhat1 flow nowhere.
+  parallel_agents(spec_.agents, [&](int i) {
+    Vec3 si = seg(vhat1, i) + h_ * seg(xhat1, i);
+    si.y() = 0;
+    if (!spec_.implicit_damping) {
+      seg(y_, i) = si / masses_[i];
+      return;
+    }
+    const double m = masses_[i] * r.divisor[i];
+    const Vec3 yi = si / m;
+    seg(y_, i) = yi;
+    q_[i] = -(yi.x() * r.force[i].x + yi.z() * r.force[i].z) * h_ * c / m;
   });
 }
 
@@ -136,10 +160,17 @@ bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
     Vec3 f = seg(u, i) + local_force(n, v, i);
     double damping;
     const Planar fn = neighbor_force(r, k, i, damping);
-    overshoot_[i] = h_ * (damping + drag) / masses_[i];
+    const double a = overshoot_[i] = h_ * (damping + drag) / masses_[i];
     f.x() += fn.x;
     f.z() += fn.z;
-    Vec3 v1 = seg(v, i) + (h_ / masses_[i]) * f;
+    Vec3 v1;
+    if (spec_.implicit_damping) {
+      r.force[i] = {f.x(), f.z()};
+      r.divisor[i] = 1 + a;
+      v1 = seg(v, i) + (h_ / (masses_[i] * (1 + a))) * f;
+    } else {
+      v1 = seg(v, i) + (h_ / masses_[i]) * f;
+    }
     v1.y() = 0;
     Vec3 x1 = seg(x, i) + h_ * v1;
     x1.y() = 0;
@@ -147,16 +178,16 @@ bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
     seg(x_next, i) = x1;
   });
   unstable_step_ = -1;
-  return x_next.allFinite() && v_next.allFinite() && stable_velocity_update(n);
+  return x_next.allFinite() && v_next.allFinite() && (spec_.implicit_damping || stable_velocity_update(n));
 }
 
 void FlockSystem::transpose_apply(int n, const VecX& x, const VecX& v, const VecX& y, int k, int j, Vec3& kt,
-                                  Vec3& dt) const {
+                                  Vec3& dt, bool summed_weights) const {
   kt.setZero();
   dt.setZero();
   if (neighbor_forces_.any()) {
     Planar kp, dp;
-    neighbor_forces_.transpose_apply(adjoint_.data(), slot_neighbors(k), k, kp, dp);
+    neighbor_forces_.transpose_apply(adjoint_.data(), slot_neighbors(k), k, kp, dp, summed_weights);
     kt = Vec3(kp.x, 0, kp.z);
     dt = Vec3(dp.x, 0, dp.z);
   }
@@ -173,21 +204,16 @@ void FlockSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX&,
   check_size(x, v);
   const FlockRecord& r = static_cast<const FlockRecord&>(record);
   const int p = spec_.agents;
-  // The step writes y = 0 whatever its inputs, so the y parts of xhat1 and vhat1 flow nowhere.
-  parallel_agents(p, [&](int i) {
-    Vec3 si = seg(vhat1, i) + h_ * seg(xhat1, i);
-    si.y() = 0;
-    seg(y_, i) = si / masses_[i];
-  });
+  adjoint_weights(r, xhat1, vhat1);
   index(x, v);  // the step's own slots and neighbours
-  pack_adjoint(r, y_);
+  pack_adjoint(r, y_, spec_.implicit_damping ? &q_ : nullptr);
   xhat.resize(dof());
   vhat.resize(dof());
   uhat.resize(dof());
   parallel_agents(p, [&](int k) {
     const int j = agent(k);
     Vec3 kt, dt;
-    transpose_apply(n, x, v, y_, k, j, kt, dt);
+    transpose_apply(n, x, v, y_, k, j, kt, dt, spec_.implicit_damping);
     const Vec3 yj = seg(y_, j);
     Vec3 xh = seg(xhat1, j) + h_ * kt;
     Vec3 vh = seg(vhat1, j) + h_ * seg(xhat1, j) + h_ * dt;  // s_j + h (D^T M^-1 s)_j
@@ -229,7 +255,7 @@ void FlockSystem::apply_KT_DT(int n, const VecX& x, const VecX& v, const VecX& y
   parallel_agents(spec_.agents, [&](int k) {
     const int j = agent(k);
     Vec3 kt, dt;
-    transpose_apply(n, x, v, y, k, j, kt, dt);
+    transpose_apply(n, x, v, y, k, j, kt, dt, false);
     seg(KTy, j) = kt;
     seg(DTy, j) = dt;
   });
@@ -246,6 +272,7 @@ std::string FlockSystem::describe() const {
   if (names.empty()) os << " none";
   for (size_t k = 0; k < names.size(); ++k) os << (k ? ", " : " ") << names[k];
   os << "; grid neighbour search, radius " << neighbor_forces_.radius() << " m";
+  if (spec_.implicit_damping) os << "; own-velocity damping implicit";
   return os.str();
 }
 

@@ -3,7 +3,14 @@
 //
 //   v1 = v + h M^-1 (f(x, v) + u),  x1 = x + h v1          (forward)
 //   s = vhat1 + h xhat1,  xhat = xhat1 + h K^T M^-1 s,  vhat = s + h D^T M^-1 s,  uhat = h M^-1 s
-// with K = df/dx, D = df/dv at (x_n, v_n) applied matrix-free. The three neighbour forces run fused in one
+// with K = df/dx, D = df/dv at (x_n, v_n) applied matrix-free.
+// With implicit damping (FlockSpec::implicit_damping) an agent's own-velocity damping, a_i v_i with
+// a_i = h (c S_i + drag) / m_i and S_i = sum_j w_ij its summed matching weights, is taken at v1 instead of v:
+//   v1_i = v_i + h/(m_i (1 + a_i)) (f_i + u_i)
+// which multiplies v_i by 1/(1 + a_i) where the explicit step multiplies it by 1 - a_i: stable however
+// densely agents pack. Its adjoint is the explicit one with M^-1 s replaced by y_i = s_i / (m_i (1 + a_i)),
+// plus, since a_i depends on x through S_i, xhat_j += h sum_i q_i dS_i/dx_j with
+// q_i = -(y_i . (f_i + u_i)) h c / (m_i (1 + a_i)); f_i + u_i and 1 + a_i come from the step's record. The three neighbour forces run fused in one
 // pass over each agent's whole list (NeighborForces), each agent summing its own pair terms in its list's
 // order, so results do not depend on the thread count; wander and drag are per-agent terms. A pair's terms
 // are computed by both of its agents: at a bunched crowd's hundreds of neighbours, storing them once and
@@ -29,10 +36,15 @@ namespace kf {
 
 // What a flock step found at its state that its adjoint cannot cheaply find again: the centering quantities
 // (offset m_i - x_i in the ground plane, m, and b_i; p each).
+// With implicit damping also each agent's total force f_i + u_i and 1 + a_i.
 struct FlockRecord final : StepRecord {
   std::vector<Planar> offset;
   std::vector<double> b;
-  std::size_t bytes() const { return offset.capacity() * sizeof(Planar) + b.capacity() * sizeof(double); }
+  std::vector<Planar> force;
+  std::vector<double> divisor;
+  std::size_t bytes() const {
+    return (offset.capacity() + force.capacity()) * sizeof(Planar) + (b.capacity() + divisor.capacity()) * sizeof(double);
+  }
 };
 
 class FlockSystem final : public System {
@@ -47,7 +59,7 @@ class FlockSystem final : public System {
   void initial_state(VecX& x, VecX& v) const override;
   bool planar() const override { return true; }
   std::unique_ptr<StepRecord> new_record() const override { return std::make_unique<FlockRecord>(); }
-  // Centering quantities: 24 bytes per agent, however the agents bunch.
+  // Centering quantities: 24 bytes per agent, however the agents bunch (48 with implicit damping).
   std::size_t record_bytes_estimate() const override;
   using System::step;
   using System::step_adjoint;
@@ -81,12 +93,16 @@ class FlockSystem final : public System {
   // step amplifies relative velocities in packed agents step after step (a 100,000-agent crowd reached
   // 3,800 m/s). Such a step is refused like a diverged one. overshoot_[i] holds h (c sum w + drag)/m_i.
   bool stable_velocity_update(int n);
-  // Packs adjoint_ in slot order for the transposed pass at the state of r (motion_ packed), applied to y.
-  void pack_adjoint(const FlockRecord& r, const VecX& y);
+  // Packs adjoint_ in slot order for the transposed pass at the state of r (motion_ packed), applied to y,
+  // with q (per agent) when given.
+  void pack_adjoint(const FlockRecord& r, const VecX& y, const std::vector<double>* q = nullptr);
+  // The adjoint's y = M^-1 s (divided by 1 + a_i with implicit damping) and, with implicit damping, q_ / h.
+  void adjoint_weights(const FlockRecord& r, const VecX& xhat1, const VecX& vhat1);
   void check_size(const VecX& x, const VecX& v) const;
-  // (K^T y)_j and (D^T y)_j of all forces for the agent j in slot k (adjoint_ packed).
-  void transpose_apply(int n, const VecX& x, const VecX& v, const VecX& y, int k, int j, Vec3& kt,
-                       Vec3& dt) const;
+  // (K^T y)_j and (D^T y)_j of all forces for the agent j in slot k (adjoint_ packed); with
+  // `summed_weights`, kt also gets the q term (adjoint_ packed with q).
+  void transpose_apply(int n, const VecX& x, const VecX& v, const VecX& y, int k, int j, Vec3& kt, Vec3& dt,
+                       bool summed_weights) const;
   Vec3 local_force(int n, const VecX& v, int i) const;  // wander + drag on agent i
 
   FlockSpec spec_;
@@ -100,6 +116,7 @@ class FlockSystem final : public System {
   std::vector<AgentAdjoint> adjoint_;  // the same with y and the centering quantities (p)
   FlockRecord scratch_;  // forces() and apply_KT_DT
   VecX y_;  // M^-1 s in the adjoint step
+  std::vector<double> q_;  // q_i / h in the adjoint step with implicit damping (p)
   std::vector<double> overshoot_;  // per agent, the last step's h (c sum w + drag)/m (p)
   int unstable_step_ = -1;         // the last step refused as unstable (-1: none), and its largest overshoot
   double unstable_overshoot_ = 0;

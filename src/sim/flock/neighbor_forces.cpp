@@ -54,9 +54,9 @@ struct NeighborForces::ForwardSum {
 };
 
 // Running sums of one agent's transposed terms (before strengths): avoidance and matching shares of K^T y,
-// matching's of D^T y, centering's of K^T y.
+// matching's of D^T y, centering's of K^T y, and the summed weights' derivative weighted by q.
 struct NeighborForces::TransposedSum {
-  Pair2 ka{0, 0}, km{0, 0}, dm{0, 0}, kc{0, 0};
+  Pair2 ka{0, 0}, km{0, 0}, dm{0, 0}, kc{0, 0}, kq{0, 0};
 };
 
 // Matching and centering of neighbour j, added to agent i's sums; returns r2. With p = x_j - x_i = -d:
@@ -89,6 +89,7 @@ inline void NeighborForces::forward_avoidance(const AgentMotion& ai, const Agent
 }
 
 // Matching and centering of neighbour i, added to agent j's transposed sums; returns r2. d = x_j - x_i.
+template <bool kSummedWeights>
 inline double NeighborForces::transposed_matching_centering(const AgentAdjoint& aj, const AgentAdjoint& ai,
                                                             TransposedSum& sum) const {
   const Pair2 d = pair(aj.x, aj.z) - pair(ai.x, ai.z);
@@ -101,6 +102,8 @@ inline double NeighborForces::transposed_matching_centering(const AgentAdjoint& 
     const double s = 2.0 * k.dw_dr2 * dot2(pair(ai.vx, ai.vz) - pair(aj.vx, aj.vz), yj - yi);
     sum.km += s * d;
     sum.dm += k.w * (yi - yj);
+    // w_ij is in S_i and S_j, and d w_ij / d x_j = 2 w' d.
+    if constexpr (kSummedWeights) sum.kq += (2.0 * k.dw_dr2 * (ai.q + aj.q)) * d;
   }
   if (r2 < rc2_) {
     // (d f_i/d x_j)^T y_i - (d f_j/d x_i)^T y_j with g_i = -2 w' d (CenteringPair::add_KT).
@@ -157,13 +160,23 @@ Planar NeighborForces::force(const AgentMotion* a, std::span<int> nbrs, int i, P
           ka_ * sum.a[1] + kmatch_ * sum.m[1] + kc_ * offset_i.z};
 }
 
-void NeighborForces::transpose_apply(const AgentAdjoint* a, std::span<int> nbrs, int j, Planar& kt,
-                                     Planar& dt) const {
-  TransposedSum sum;
+template <bool kSummedWeights>
+void NeighborForces::transposed_sums(const AgentAdjoint* a, std::span<int> nbrs, int j, TransposedSum& sum) const {
   sum_in_two_passes(
-      nbrs, ra2_, [&](int i) { return transposed_matching_centering(a[j], a[i], sum); },
+      nbrs, ra2_, [&](int i) { return transposed_matching_centering<kSummedWeights>(a[j], a[i], sum); },
       [&](int i) { transposed_avoidance(a[j], a[i], sum); });
+}
+
+void NeighborForces::transpose_apply(const AgentAdjoint* a, std::span<int> nbrs, int j, Planar& kt, Planar& dt,
+                                     bool summed_weights) const {
+  TransposedSum sum;
+  if (summed_weights) {
+    transposed_sums<true>(a, nbrs, j, sum);
+  } else {
+    transposed_sums<false>(a, nbrs, j, sum);
+  }
   kt = {ka_ * sum.ka[0] + kmatch_ * sum.km[0] + sum.kc[0], ka_ * sum.ka[1] + kmatch_ * sum.km[1] + sum.kc[1]};
+  if (summed_weights) kt = {kt.x + sum.kq[0], kt.z + sum.kq[1]};
   dt = {kmatch_ * sum.dm[0], kmatch_ * sum.dm[1]};
 }
 

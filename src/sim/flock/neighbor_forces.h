@@ -25,9 +25,10 @@ struct AgentMotion {
 };
 
 // One agent as the transposed pass reads it: its motion, y (the vector K^T and D^T are applied to), its
-// centering offset (m) and c / b for centering strength c.
+// centering offset (m), c / b for centering strength c, and q, the weight of the derivative of its summed
+// matching weights (0 unless the step takes damping implicitly: FlockSystem).
 struct AgentAdjoint {
-  double x, z, vx, vz, yx, yz, ox, oz, c_over_b;
+  double x, z, vx, vz, yx, yz, ox, oz, c_over_b, q;
 };
 
 // Planar vectors of the pair loops (x, z).
@@ -51,8 +52,10 @@ class NeighborForces {
                double& damping_i) const;
 
   // a: all agents (y, offsets and c/b filled); nbrs: neighbours of j, reordered (work space). Returns
-  // (K^T y)_j in kt and (D^T y)_j in dt.
-  void transpose_apply(const AgentAdjoint* a, std::span<int> nbrs, int j, Planar& kt, Planar& dt) const;
+  // (K^T y)_j in kt and (D^T y)_j in dt. With `summed_weights`, kt also gets sum_i (q_i + q_j) dS_i/dx_j
+  // over the agents' summed matching weights S_i = sum_k w_ik (i = j included).
+  void transpose_apply(const AgentAdjoint* a, std::span<int> nbrs, int j, Planar& kt, Planar& dt,
+                       bool summed_weights = false) const;
 
  private:
   // Running sums of one agent's pair terms, and one pair's terms added to them: avoidance (for a neighbour
@@ -62,7 +65,10 @@ class NeighborForces {
   void forward_avoidance(const AgentMotion& ai, const AgentMotion& aj, ForwardSum& sum) const;
   double forward_matching_centering(const AgentMotion& ai, const AgentMotion& aj, ForwardSum& sum) const;
   void transposed_avoidance(const AgentAdjoint& aj, const AgentAdjoint& ai, TransposedSum& sum) const;
+  template <bool kSummedWeights>
   double transposed_matching_centering(const AgentAdjoint& aj, const AgentAdjoint& ai, TransposedSum& sum) const;
+  template <bool kSummedWeights>
+  void transposed_sums(const AgentAdjoint* a, std::span<int> nbrs, int j, TransposedSum& sum) const;
 
   double ka_, kmatch_, kc_;           // strengths
   double ra2_, rm2_, rc2_;            // squared radii, 0 for a term that is off
