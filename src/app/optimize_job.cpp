@@ -116,7 +116,8 @@ class EvaluationLog {
 // from the best point after a stalled line search, with what is left of the budget, while they make progress.
 OptimizeResult run_stage(Problem& problem, OptimizerSpec spec, int restarts, const VecX& z, int stage_id,
                          int substeps, double seconds_before, EvaluationLog& elog, Progress& progress,
-                         EvaluationTape& tape, const std::function<bool(const VecX&, double&)>& before_restart) {
+                         EvaluationTape& tape, const std::function<bool(const VecX&, double&)>& before_restart,
+                         const std::function<bool()>& reached) {
   const int budget = spec.max_evaluations;
   int used = 0;       // evaluations of the earlier starts of this stage
   double before = 0;  // and their seconds
@@ -126,7 +127,7 @@ OptimizeResult run_stage(Problem& problem, OptimizerSpec spec, int restarts, con
     r.seconds += before;
     elog.record(stage_id, substeps, seconds_before, r, progress);
   };
-  OptimizeResult res = minimize(problem, spec, z, on_eval, &g_stop, &tape);
+  OptimizeResult res = minimize(problem, spec, z, on_eval, &g_stop, &tape, reached);
   for (int k = 0; k < restarts && !res.interrupted; ++k) {
     const int left = budget - int(res.history.size());
     if (res.status.rfind("stopped: line search", 0) != 0 || left < 3) break;
@@ -138,7 +139,7 @@ OptimizeResult run_stage(Problem& problem, OptimizerSpec spec, int restarts, con
     const VecX best = res.z;
     double best_phi = res.phi;
     if (before_restart && !before_restart(best, best_phi)) break;
-    OptimizeResult more = minimize(problem, spec, best, on_eval, &g_stop, &tape);
+    OptimizeResult more = minimize(problem, spec, best, on_eval, &g_stop, &tape, reached);
     more.seconds += before;
     more.evaluations += res.evaluations;
     more.history.insert(more.history.begin(), res.history.begin(), res.history.end());
@@ -563,6 +564,25 @@ void search_throws_first(const JobContext& c, JobResult& job) {
   hold_split_schedule(job, job.z);
 }
 
+// optimizer.stop_when_reached: whether the problem's last rollout meets every keyframe's tolerance, judged
+// as report.json judges the result, from the rollout's frames. A checkpointed rollout keeps too few of them to
+// judge: the log says so once, and the run goes on by its other rules.
+std::function<bool()> keyframes_reached(const JobContext& c, Problem& problem) {
+  if (!c.scene.optimizer.stop_when_reached) return {};
+  return [&c, &problem, warned = false]() mutable {
+    const Rollout& r = problem.rollout();
+    if (r.every != 0) {
+      if (!warned) c.elog.say("stop_when_reached: not judged while the rollout is checkpointed");
+      warned = true;
+      return false;
+    }
+    const nlohmann::json m = figure_measures(c.scene, frames_of(r, problem.time(), problem.system().particles()));
+    for (const KeyframeJudgement& k : judge_keyframes(c.scene, m, m))
+      if (!k.met()) return false;
+    return true;
+  };
+}
+
 // Stage s of the coarse-to-fine continuation: its system (the first is built already), problem and optimisation.
 void run_job_stage(const JobContext& c, const std::vector<StageSpec>& stages, size_t s, JobResult& job,
                    TimeSpec& z_time) {
@@ -586,7 +606,8 @@ void run_job_stage(const JobContext& c, const std::vector<StageSpec>& stages, si
   const auto rehold = [&](const VecX& z, double& phi) { return rehold_split_schedule(job, z, phi); };
   const OptimizeResult res = run_stage(problem, spec, c.scene.optimizer.restarts, job.z, stage_id, job.time.substeps,
                                        job.seconds, c.elog, progress, job.tape,
-                                       job.hold_splits ? rehold : std::function<bool(const VecX&, double&)>());
+                                       job.hold_splits ? rehold : std::function<bool(const VecX&, double&)>(),
+                                       keyframes_reached(c, problem));
   progress.finish();
   record_stage(res, job);
 }
@@ -594,7 +615,7 @@ void run_job_stage(const JobContext& c, const std::vector<StageSpec>& stages, si
 // Runs stages[first], stages[first + 1], ...: a stage that converged or stalled early leaves its unspent
 // evaluations to the next (unless --max-evaluations sets every stage's).
 void run_stages(const JobContext& c, std::vector<StageSpec>& stages, size_t first, JobResult& job, TimeSpec& z_time) {
-  for (size_t s = first; s < stages.size() && !job.interrupted; ++s) {
+  for (size_t s = first; s < stages.size() && !job.interrupted && job.status != kKeyframesReached; ++s) {
     run_job_stage(c, stages, s, job, z_time);
     if (s + 1 < stages.size() && c.opt.max_evaluations < 0)
       stages[s + 1].max_evaluations += std::max(0, stages[s].max_evaluations - job.stages.back().evaluations);

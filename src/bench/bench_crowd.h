@@ -18,6 +18,9 @@ struct CrowdSweepOptions {
   // Keep the scene's coverage terms (shapes filled, not only entered); the results then go to
   // flock_crowd_coverage.csv and its plots, the runs to <out>/crowd/square-N-coverage*.
   bool coverage = false;
+  // Each run stops at its first evaluation that meets both shapes (optimizer.stop_when_reached); the runs
+  // are then named square-N-reached.
+  bool stop_when_reached = false;
 };
 
 // Writes <out>/flock_crowd.csv, flock_crowd_time.png, flock_crowd_memory.png (flock_crowd_coverage.* with

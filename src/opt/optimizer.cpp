@@ -10,10 +10,14 @@ namespace kf {
 namespace {
 
 struct Driver {
+  Driver(Problem& p, const std::function<void(const EvaluationRecord&)>& e, const std::atomic<bool>* s,
+         EvaluationTape* t, const std::function<bool()>& r)
+      : problem(p), on_eval(e), stop(s), tape(t), reached(r) {}
   Problem& problem;
   const std::function<void(const EvaluationRecord&)>& on_eval;
   const std::atomic<bool>* stop;
   EvaluationTape* tape;
+  const std::function<bool()>& reached;
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
   OptimizeResult result;
   VecX z, g;
@@ -57,6 +61,8 @@ struct Driver {
 
   // φ (and dφ/dz into *gz) at z, recorded as one evaluation.
   double evaluate(VecX* gz) {
+    // NLopt may call once more after a forced stop before it returns.
+    if (result.reached) throw nlopt::forced_stop();
     if (stop && stop->load()) {
       result.interrupted = true;
       throw nlopt::forced_stop();
@@ -92,13 +98,19 @@ struct Driver {
     rec.grad_norm = gz ? gz->norm() : 0;
     const double step = result.evaluations > 1 ? (z - result.z).norm() : 0.0;
     if (rec.unstable) reach = 0.5 * step;
+    bool met = false;
     if (!rec.diverged && phi < result.phi) {
       if (step > 0.5 * reach) reach *= 2;
       result.phi = phi;
       result.z = z;
+      met = reached && !replayed && reached();
     }
     if (on_eval) on_eval(rec);
     result.history.push_back(std::move(rec));
+    if (met) {
+      result.reached = true;
+      throw nlopt::forced_stop();
+    }
     return phi;
   }
 
@@ -123,8 +135,8 @@ std::string status_name(nlopt::result r) {
 
 OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX& z0,
                         const std::function<void(const EvaluationRecord&)>& on_eval,
-                        const std::atomic<bool>* stop, EvaluationTape* tape) {
-  Driver d{problem, on_eval, stop, tape};
+                        const std::atomic<bool>* stop, EvaluationTape* tape, const std::function<bool()>& reached) {
+  Driver d(problem, on_eval, stop, tape, reached);
   d.result.phi = std::numeric_limits<double>::infinity();
   d.result.z = z0;
   const unsigned n = unsigned(z0.size());
@@ -176,6 +188,7 @@ OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX&
     // is an interruption too: the run stops because it was told to, whatever NLopt said.
     if (stop && stop->load()) d.result.interrupted = true;
     if (d.result.interrupted) d.result.status = "interrupted";
+    else if (d.result.reached) d.result.status = kKeyframesReached;
     else if (d.limit_reached) d.result.status = status_name(nlopt::MAXEVAL_REACHED);
   }
   d.result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d.start).count();

@@ -29,15 +29,21 @@ struct OptimizeResult {
   std::string status;   // why it stopped
   bool interrupted = false;
   int capped_trials = 0;  // trials refused unsimulated as farther than the reach left by an unstable one
+  bool reached = false;   // stopped because `reached` said the best point meets the keyframes
   std::vector<EvaluationRecord> history;
 };
 
 // Minimises φ from z0 within spec.max_evaluations (a hard limit). `on_eval` sees each evaluation as it
 // happens; setting *stop makes the next evaluation end the optimisation with the best point so far (used for
 // SIGINT/SIGTERM). With a `tape`, every evaluation is recorded on it, and evaluations it replays (an
-// interrupted run resumed) are taken from it instead of computed.
+// interrupted run resumed) are taken from it instead of computed. `reached`, when given, is asked after each
+// simulated evaluation that improves on the best point (the problem's rollout is then that point's); true
+// ends the optimisation there, with status kKeyframesReached.
 OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX& z0,
                         const std::function<void(const EvaluationRecord&)>& on_eval = {},
-                        const std::atomic<bool>* stop = nullptr, EvaluationTape* tape = nullptr);
+                        const std::atomic<bool>* stop = nullptr, EvaluationTape* tape = nullptr,
+                        const std::function<bool()>& reached = {});
+
+inline constexpr const char* kKeyframesReached = "keyframes reached";
 
 }  // namespace kf

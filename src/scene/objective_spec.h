@@ -139,6 +139,9 @@ struct OptimizerSpec {
   // Strategy auto, initial_velocity controls: rigid throws simulated (forward only) before the rigid
   // stage, which starts from the best (opt/throw_search.h). < 0: automatic (automatic_throw_count); 0: off.
   int throw_search = -1;
+  // Stop as soon as an evaluation's result meets every keyframe's tolerance (the tolerances report.json
+  // judges by, opt/diagnosis.h), instead of polishing it until the objective stops changing.
+  bool stop_when_reached = false;
 };
 
 }  // namespace kf

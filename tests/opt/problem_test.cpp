@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <limits>
 
 #include "opt/gradcheck.h"
 #include "opt/optimizer.h"
@@ -263,6 +264,49 @@ TEST(Optimizer, AStopAskedForDuringTheLastEvaluationIsAnInterruption) {
   const OptimizeResult whole = minimize(problem, spec, problem.initial_guess(), {}, &no_stop);
   EXPECT_FALSE(whole.interrupted);
   EXPECT_EQ(whole.status, "evaluation limit reached");
+}
+
+// optimizer.stop_when_reached's predicate: asked only after evaluations that improve on the best point, with
+// the problem holding that point's rollout, and a true answer ends the run there, with no evaluation after it.
+TEST(Optimizer, AReachedAnswerEndsTheRunAtTheBestPointItWasAskedAbout) {
+  Scene scene = toy_scene("per_frame", 2);
+  scene.controls.alpha = 1e-6;
+  test::ToySystem sys(4, scene.time.h());
+  Problem problem(scene, scene.time, sys);
+  OptimizerSpec spec;
+  spec.max_evaluations = 200;
+  const VecX z0 = problem.initial_guess();
+  const OptimizeResult whole = minimize(problem, spec, z0);
+  const double target = 1e-2 * whole.history.front().phi;
+  // The first evaluation of the whole run below the target, and the best before it: the same path until then.
+  int first_below = 0, improving = 0;
+  double best = std::numeric_limits<double>::infinity();
+  for (const EvaluationRecord& r : whole.history) {
+    if (r.diverged || !(r.phi < best)) continue;
+    best = r.phi;
+    ++improving;
+    if (r.phi < target) {
+      first_below = r.evaluation;
+      break;
+    }
+  }
+  ASSERT_GT(first_below, 2);
+  ASSERT_LT(first_below, whole.evaluations);
+  int asked = 0;
+  const auto reached = [&] {
+    ++asked;
+    double phi = 0;
+    for (const auto& [name, value] : problem.breakdown()) phi += value;
+    return phi < target;
+  };
+  const OptimizeResult r = minimize(problem, spec, z0, {}, nullptr, nullptr, reached);
+  EXPECT_EQ(r.evaluations, first_below);
+  EXPECT_EQ(r.status, kKeyframesReached);
+  EXPECT_TRUE(r.reached);
+  EXPECT_FALSE(r.interrupted);
+  EXPECT_LT(r.phi, target);
+  EXPECT_EQ(r.phi, whole.history[first_below - 1].phi);
+  EXPECT_EQ(asked, improving);  // not after the evaluations that did not improve
 }
 
 // The toy chain with heavy keyframes and cheap effort, and the largest control force of its optimum
