@@ -49,6 +49,37 @@ TEST(NeighborGrid, EqualsBruteForce) {
   EXPECT_GT(total, 10000) << "the configurations must actually have neighbours";
 }
 
+// The scan that tests eight candidates at once (AVX-512, where the processor has it) lists exactly what the
+// scalar scan lists, in the same order, on crowds dense enough that runs hold many candidates, with agents
+// at the cut-off and coincident ones.
+TEST(NeighborGrid, EightAtATimeScanListsWhatTheScalarScanLists) {
+  std::mt19937_64 rng(12);
+  long total = 0;
+  for (double box : {2.0, 10.0})
+    for (int p : {50, 3000}) {
+      std::uniform_real_distribution<double> u(-box, box);
+      VecX x = VecX::Zero(3 * p);
+      for (int i = 0; i < p; ++i) x[3 * i] = u(rng), x[3 * i + 2] = u(rng);
+      for (int i = 0; i + 3 < p; i += 7) {
+        seg(x, i + 1) = seg(x, i);
+        seg(x, i + 2) = seg(x, i) + Vec3(1.5, 0, 0);  // exactly at the cut-off
+        seg(x, i + 3) = seg(x, i) + Vec3(0, 0, 1.5 * (1 - 1e-15));
+      }
+      NeighborGrid::allow_simd(false);
+      NeighborGrid scalar;
+      scalar.build(x, 1.5);
+      NeighborGrid::allow_simd(true);
+      NeighborGrid simd;
+      simd.build(x, 1.5);
+      for (int i = 0; i < p; ++i) {
+        auto a = scalar.neighbors(i), b = simd.neighbors(i);
+        ASSERT_EQ(std::vector<int>(a.begin(), a.end()), std::vector<int>(b.begin(), b.end())) << "agent " << i;
+        total += long(a.size());
+      }
+    }
+  EXPECT_GT(total, 100000);
+}
+
 TEST(NeighborGrid, WrappedTableEqualsBruteForce) {
   // A line of agents far wider than the table has columns, and a few strays far off: cells share buckets
   // (rows and columns wrap), and lists keep their order.

@@ -1,8 +1,12 @@
 #include "sim/flock/neighbor_grid.h"
 
 #include <algorithm>
+#include <atomic>
 #include <climits>
 #include <cmath>
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#endif
 
 #include "core/check.h"
 #include "sim/flock/parallel_agents.h"
@@ -20,7 +24,44 @@ int64_t cell_index(double c, double inv_cell) {
   return int64_t(q);
 }
 
+#if defined(__x86_64__) && defined(__GNUC__)
+#define KF_GATHER_AVX512 1
+// Candidates s in [s, e) of an unwrapped run within r2 of (xi, zi), other than slot k, appended to out from
+// entry n, eight at a time (the run's last few masked) while eight more fit below cap; returns the new n and
+// advances s past those tested (the caller's scalar loop takes any left: a list about to outgrow out). Lanes are compressed in order, so the list is the scalar
+// loop's; fp-contract=off keeps each product and sum rounded as the scalar code rounds it.
+__attribute__((target("avx512f,avx512vl"), optimize("fp-contract=off"))) int gather_eight_at_a_time(
+    const double* px, const double* pz, double xi, double zi, double r2, int k, int& s, int e, int cap, int* out,
+    int n) {
+  const __m512d vx = _mm512_set1_pd(xi), vz = _mm512_set1_pd(zi), vr2 = _mm512_set1_pd(r2);
+  const __m256i vk = _mm256_set1_epi32(k), eight = _mm256_set1_epi32(8);
+  __m256i slot = _mm256_add_epi32(_mm256_set1_epi32(s), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+  for (; s < e && n + 8 <= cap; s += 8) {
+    const __mmask8 lanes = e - s >= 8 ? __mmask8(0xff) : __mmask8((1u << (e - s)) - 1);  // the run's last few
+    const __m512d ex = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, px + s), vx);
+    const __m512d ez = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, pz + s), vz);
+    const __m512d d2 = _mm512_add_pd(_mm512_mul_pd(ex, ex), _mm512_mul_pd(ez, ez));
+    const __mmask8 hit = _mm512_cmp_pd_mask(d2, vr2, _CMP_LT_OQ) & ~_mm256_cmpeq_epi32_mask(slot, vk) & lanes;
+    // Compressed in a register and stored whole (entries past the hits are overwritten later or unused; n + 8
+    // <= cap keeps them in the buffer): a compressing store to memory is microcoded and slow on some cores.
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + n), _mm256_maskz_compress_epi32(hit, slot));
+    n += __builtin_popcount(unsigned(hit));
+    slot = _mm256_add_epi32(slot, eight);
+  }
+  return n;
+}
+
+bool avx512_available() {
+  static const bool has = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
+  return has;
+}
+#endif
+
+std::atomic<bool> g_simd_allowed{true};
+
 }  // namespace
+
+void NeighborGrid::allow_simd(bool on) { g_simd_allowed = on; }
 
 template <bool kWrapped>
 int NeighborGrid::gather_run(int k, int s, int e, int64_t cx0, int64_t cz, double r2, int cap, int* out,
@@ -29,6 +70,12 @@ int NeighborGrid::gather_run(int k, int s, int e, int64_t cx0, int64_t cz, doubl
   // within the radius and not k, and in a wrapped table only when in one of the run's cells (a bucket
   // then holds cells far apart).
   const double xi = sorted_px_[k], zi = sorted_pz_[k];
+#ifdef KF_GATHER_AVX512
+  if constexpr (!kWrapped) {
+    if (avx512_available() && g_simd_allowed.load(std::memory_order_relaxed))
+      n = gather_eight_at_a_time(sorted_px_.data(), sorted_pz_.data(), xi, zi, r2, k, s, e, cap, out, n);
+  }
+#endif
   for (; s < e; ++s) {
     const double ex = sorted_px_[s] - xi, ez = sorted_pz_[s] - zi;
     bool hit = (ex * ex + ez * ez < r2) & (s != k);
