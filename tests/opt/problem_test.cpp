@@ -231,16 +231,29 @@ TEST(Problem, LatticeVelocitiesHoldARigidThrowExactlyAndGatherIsTheirTranspose) 
   EXPECT_NEAR((v_z - v0_scene).dot(dv), z.dot(dz), 1e-12);
 }
 
-TEST(Optimizer, ReducesTheObjectiveByOrdersOfMagnitude) {
+// The toy chain with nearly free control effort, and 200 evaluations for L-BFGS.
+Scene cheap_effort_scene() {
   Scene scene = toy_scene("per_frame", 2);
   scene.controls.alpha = 1e-6;
-  test::ToySystem sys(4, scene.time.h());
-  Problem problem(scene, scene.time, sys);
-  OptimizerSpec spec;
-  spec.max_evaluations = 200;
+  return scene;
+}
+struct CheapEffortToy {
+  Scene scene = cheap_effort_scene();
+  test::ToySystem sys{4, scene.time.h()};
+  Problem problem{scene, scene.time, sys};
+  OptimizerSpec spec = [] {
+    OptimizerSpec s;
+    s.max_evaluations = 200;
+    return s;
+  }();
+};
+
+TEST(Optimizer, ReducesTheObjectiveByOrdersOfMagnitude) {
+  CheapEffortToy toy;
+  Problem& problem = toy.problem;
   const VecX z0 = problem.initial_guess();
   const double phi0 = problem.evaluate(z0, nullptr);
-  const OptimizeResult r = minimize(problem, spec, z0);
+  const OptimizeResult r = minimize(problem, toy.spec, z0);
   EXPECT_LT(r.phi, 1e-3 * phi0) << r.status;
   EXPECT_GT(r.evaluations, 2);
 }
@@ -269,12 +282,9 @@ TEST(Optimizer, AStopAskedForDuringTheLastEvaluationIsAnInterruption) {
 // optimizer.stop_when_reached's predicate: asked only after evaluations that improve on the best point, with
 // the problem holding that point's rollout, and a true answer ends the run there, with no evaluation after it.
 TEST(Optimizer, AReachedAnswerEndsTheRunAtTheBestPointItWasAskedAbout) {
-  Scene scene = toy_scene("per_frame", 2);
-  scene.controls.alpha = 1e-6;
-  test::ToySystem sys(4, scene.time.h());
-  Problem problem(scene, scene.time, sys);
-  OptimizerSpec spec;
-  spec.max_evaluations = 200;
+  CheapEffortToy toy;
+  Problem& problem = toy.problem;
+  const OptimizerSpec& spec = toy.spec;
   const VecX z0 = problem.initial_guess();
   const OptimizeResult whole = minimize(problem, spec, z0);
   const double target = 1e-2 * whole.history.front().phi;
