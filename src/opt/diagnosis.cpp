@@ -279,8 +279,9 @@ std::string unstable_cause(const RunFacts& facts) {
   return format("cause: %.0f of its %.0f evaluations were trial steps whose simulation was refused as unstable ",
                 double(facts.unstable_trials), double(facts.evaluations)) +
          (facts.flock ? "(agents packed so densely that the explicit step overshoots their velocity matching), so "
-                        "the search crept along that edge; change: finer time steps (time.substeps), a later "
-                        "keyframe so the agents need not rush, or a lower flock.matching.strength"
+                        "the search crept along that edge; change: flock.step \"implicit_damping\" (stable however "
+                        "densely they pack), finer time steps (time.substeps), a later keyframe so the agents need not "
+                        "rush, or a lower flock.matching.strength"
                       : "(its step cannot follow the state they reach), so the search crept along that edge; change: "
                         "finer time steps (time.substeps)");
 }

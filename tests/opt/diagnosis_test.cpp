@@ -197,6 +197,7 @@ TEST(Diagnosis, TrialsRefusedAsUnstableAreNamedWhenThereAreMany) {
   f.unstable_trials = 29;
   const std::string line = diagnose(k, s, f).line;
   EXPECT_NE(line.find("29 of its 60 evaluations"), std::string::npos) << line;
+  EXPECT_NE(line.find("implicit_damping"), std::string::npos) << line;
   EXPECT_NE(line.find("time.substeps"), std::string::npos) << line;
   EXPECT_EQ(line.find("collider"), std::string::npos) << line;
   f.unstable_trials = 2;
