@@ -6,6 +6,7 @@
 #include <random>
 #include <vector>
 
+#include "sim/flock/flock_simd.h"
 #include "sim/flock/neighbor_grid.h"
 
 namespace kf {
@@ -42,7 +43,8 @@ TEST(NeighborGrid, EqualsBruteForce) {
         for (int i = 0; i < p; ++i) {
           auto got = grid.neighbors(i);
           const std::vector<int> want = brute_force(x, i, radius);
-          ASSERT_EQ(std::vector<int>(got.begin(), got.end()), want) << "p " << p << " box " << box << " radius " << radius << " agent " << i;
+          ASSERT_EQ(std::vector<int>(got.begin(), got.end()), want)
+              << "p " << p << " box " << box << " radius " << radius << " agent " << i;
           total += long(want.size());
         }
       }
@@ -65,10 +67,10 @@ TEST(NeighborGrid, EightAtATimeScanListsWhatTheScalarScanLists) {
         seg(x, i + 2) = seg(x, i) + Vec3(1.5, 0, 0);  // exactly at the cut-off
         seg(x, i + 3) = seg(x, i) + Vec3(0, 0, 1.5 * (1 - 1e-15));
       }
-      NeighborGrid::allow_simd(false);
+      allow_flock_simd(false);
       NeighborGrid scalar;
       scalar.build(x, 1.5);
-      NeighborGrid::allow_simd(true);
+      allow_flock_simd(true);
       NeighborGrid simd;
       simd.build(x, 1.5);
       for (int i = 0; i < p; ++i) {

@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "sim/flock/avoidance_force.h"
+#include "sim/flock/flock_simd.h"
+#include "sim/flock/neighbor_pair_sums.h"
 #include "sim/flock/smooth_kernel.h"
 
 namespace kf {
@@ -28,36 +30,6 @@ NeighborForces::NeighborForces(const FlockSpec& s)
   if (kmatch_ > 0) radius_ = std::max(radius_, s.matching.radius);
   if (kc_ > 0) radius_ = std::max(radius_, s.centering.radius);
 }
-
-// The pair formulas on (x, z) pairs: every operation acts on both components at once, in the same order
-// and with the same operands as the scalar formula of each component, so the results are bit for bit those
-// of the scalar formulas (no fused multiply-add: the baseline instruction set has none). A pair's sums over
-// components (r^2 and dot products) add x then z, as the scalar formulas do.
-namespace {
-
-typedef double Pair2 __attribute__((vector_size(16)));
-
-inline Pair2 pair(double x, double z) { return Pair2{x, z}; }
-inline double dot2(Pair2 a, Pair2 b) {
-  const Pair2 m = a * b;
-  return m[0] + m[1];
-}
-
-}  // namespace
-
-// Running sums of one agent's forward terms (before strengths): avoidance sum w g d in a, matching
-// w (v_j - v_i) in m and its weights in wm, centering's a_i = -sum w d in c and b_i = 1 + sum w in w (the
-// agent's own weight 1); d = x_i - x_j.
-struct NeighborForces::ForwardSum {
-  Pair2 a{0, 0}, m{0, 0}, c{0, 0};
-  double w = 1.0, wm = 0;
-};
-
-// Running sums of one agent's transposed terms (before strengths): avoidance and matching shares of K^T y,
-// matching's of D^T y, centering's of K^T y, and the summed weights' derivative weighted by q.
-struct NeighborForces::TransposedSum {
-  Pair2 ka{0, 0}, km{0, 0}, dm{0, 0}, kc{0, 0}, kq{0, 0};
-};
 
 // Matching and centering of neighbour j, added to agent i's sums; returns r2. With p = x_j - x_i = -d:
 // w (v_j - v_i) is added to m, and a_i -= w d is a_i += w p. The branches skip terms out of reach (their
@@ -150,9 +122,16 @@ void sum_in_two_passes(std::span<int> nbrs, double ra2, Every every, Near near) 
 Planar NeighborForces::force(const AgentMotion* a, std::span<int> nbrs, int i, Planar& offset_i, double& b_i,
                              double& damping_i) const {
   ForwardSum sum;
-  sum_in_two_passes(
-      nbrs, ra2_, [&](int j) { return forward_matching_centering(a[i], a[j], sum); },
-      [&](int j) { forward_avoidance(a[i], a[j], sum); });
+#ifdef KF_FLOCK_AVX512
+  if (flock_simd_enabled()) {
+    forward_eight_wide(a, nbrs, i, sum);
+  } else
+#endif
+  {
+    sum_in_two_passes(
+        nbrs, ra2_, [&](int j) { return forward_matching_centering(a[i], a[j], sum); },
+        [&](int j) { forward_avoidance(a[i], a[j], sum); });
+  }
   offset_i = {sum.c[0] / sum.w, sum.c[1] / sum.w};
   b_i = sum.w;
   damping_i = kmatch_ * sum.wm;
@@ -162,6 +141,9 @@ Planar NeighborForces::force(const AgentMotion* a, std::span<int> nbrs, int i, P
 
 template <bool kSummedWeights>
 void NeighborForces::transposed_sums(const AgentAdjoint* a, std::span<int> nbrs, int j, TransposedSum& sum) const {
+#ifdef KF_FLOCK_AVX512
+  if (flock_simd_enabled()) return transposed_eight_wide<kSummedWeights>(a, nbrs, j, sum);
+#endif
   sum_in_two_passes(
       nbrs, ra2_, [&](int i) { return transposed_matching_centering<kSummedWeights>(a[j], a[i], sum); },
       [&](int i) { transposed_avoidance(a[j], a[i], sum); });

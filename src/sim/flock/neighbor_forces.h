@@ -16,6 +16,7 @@
 
 #include "core/types.h"
 #include "scene/flock_spec.h"
+#include "sim/flock/flock_simd.h"
 
 namespace kf {
 
@@ -69,11 +70,17 @@ class NeighborForces {
   double transposed_matching_centering(const AgentAdjoint& aj, const AgentAdjoint& ai, TransposedSum& sum) const;
   template <bool kSummedWeights>
   void transposed_sums(const AgentAdjoint* a, std::span<int> nbrs, int j, TransposedSum& sum) const;
+#ifdef KF_FLOCK_AVX512
+  // The same sums, eight neighbours at a time (neighbor_forces_eight_wide.cpp).
+  void forward_eight_wide(const AgentMotion* a, std::span<const int> nbrs, int i, ForwardSum& sum) const;
+  template <bool kSummedWeights>
+  void transposed_eight_wide(const AgentAdjoint* a, std::span<const int> nbrs, int j, TransposedSum& sum) const;
+#endif
 
-  double ka_, kmatch_, kc_;           // strengths
-  double ra2_, rm2_, rc2_;            // squared radii, 0 for a term that is off
+  double ka_, kmatch_, kc_;             // strengths
+  double ra2_, rm2_, rc2_;              // squared radii, 0 for a term that is off
   double inv_ra2_, inv_rm2_, inv_rc2_;  // 1/R^2 of each term
-  double eps2_;                       // avoidance softening^2 (m^2)
+  double eps2_;                         // avoidance softening^2 (m^2)
   // Matching and centering both on with one radius: a pair's kernel weight serves both (the same value).
   bool same_mc_;
   double radius_ = 0;

@@ -1,14 +1,14 @@
 #include "sim/flock/neighbor_grid.h"
 
 #include <algorithm>
-#include <atomic>
 #include <climits>
 #include <cmath>
-#if defined(__x86_64__) && defined(__GNUC__)
-#include <immintrin.h>
-#endif
 
 #include "core/check.h"
+#include "sim/flock/flock_simd.h"
+#ifdef KF_FLOCK_AVX512
+#include <immintrin.h>
+#endif
 #include "sim/flock/parallel_agents.h"
 
 namespace kf {
@@ -24,15 +24,13 @@ int64_t cell_index(double c, double inv_cell) {
   return int64_t(q);
 }
 
-#if defined(__x86_64__) && defined(__GNUC__)
-#define KF_GATHER_AVX512 1
+#ifdef KF_FLOCK_AVX512
 // Candidates s in [s, e) of an unwrapped run within r2 of (xi, zi), other than slot k, appended to out from
 // entry n, eight at a time (the run's last few masked) while eight more fit below cap; returns the new n and
-// advances s past those tested (the caller's scalar loop takes any left: a list about to outgrow out). Lanes are compressed in order, so the list is the scalar
-// loop's; fp-contract=off keeps each product and sum rounded as the scalar code rounds it.
-__attribute__((target("avx512f,avx512vl"), optimize("fp-contract=off"))) int gather_eight_at_a_time(
-    const double* px, const double* pz, double xi, double zi, double r2, int k, int& s, int e, int cap, int* out,
-    int n) {
+// advances s past those tested (the caller's scalar loop takes any left: a list about to outgrow out). Lanes are
+// compressed in order, so the list is the scalar loop's (flock_simd.h).
+KF_EIGHT_WIDE int gather_eight_at_a_time(const double* px, const double* pz, double xi, double zi, double r2, int k,
+                                         int& s, int e, int cap, int* out, int n) {
   const __m512d vx = _mm512_set1_pd(xi), vz = _mm512_set1_pd(zi), vr2 = _mm512_set1_pd(r2);
   const __m256i vk = _mm256_set1_epi32(k), eight = _mm256_set1_epi32(8);
   __m256i slot = _mm256_add_epi32(_mm256_set1_epi32(s), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
@@ -50,29 +48,19 @@ __attribute__((target("avx512f,avx512vl"), optimize("fp-contract=off"))) int gat
   }
   return n;
 }
-
-bool avx512_available() {
-  static const bool has = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
-  return has;
-}
 #endif
-
-std::atomic<bool> g_simd_allowed{true};
 
 }  // namespace
 
-void NeighborGrid::allow_simd(bool on) { g_simd_allowed = on; }
-
 template <bool kWrapped>
-int NeighborGrid::gather_run(int k, int s, int e, int64_t cx0, int64_t cz, double r2, int cap, int* out,
-                             int n) const {
+int NeighborGrid::gather_run(int k, int s, int e, int64_t cx0, int64_t cz, double r2, int cap, int* out, int n) const {
   // Branch-free: every candidate is written to the next free entry (or the scratch one) and counted when
   // within the radius and not k, and in a wrapped table only when in one of the run's cells (a bucket
   // then holds cells far apart).
   const double xi = sorted_px_[k], zi = sorted_pz_[k];
-#ifdef KF_GATHER_AVX512
+#ifdef KF_FLOCK_AVX512
   if constexpr (!kWrapped) {
-    if (avx512_available() && g_simd_allowed.load(std::memory_order_relaxed))
+    if (flock_simd_enabled())
       n = gather_eight_at_a_time(sorted_px_.data(), sorted_pz_.data(), xi, zi, r2, k, s, e, cap, out, n);
   }
 #endif
@@ -93,8 +81,8 @@ int NeighborGrid::gather(int k, double r2, int cap, int* out) const {
   for (int64_t row = cz - kReach; row <= cz + kReach; ++row) {
     if ((uint64_t(cx - kReach - origin_x_) & column_mask_) + 2 * kReach <= column_mask_) {  // consecutive buckets
       const uint64_t b = bucket_of(cx - kReach, row);
-      n = gather_run<kWrapped>(k, bucket_start_[b], bucket_start_[b + 2 * kReach + 1], cx - kReach, row, r2, cap,
-                               out, n);
+      n = gather_run<kWrapped>(k, bucket_start_[b], bucket_start_[b + 2 * kReach + 1], cx - kReach, row, r2, cap, out,
+                               n);
       continue;
     }
     for (int64_t c = cx - kReach; c <= cx + kReach; ++c) {  // the row wraps: one cell at a time, in column order

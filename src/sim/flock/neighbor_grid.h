@@ -39,10 +39,6 @@ class NeighborGrid {
   int agent_at(int slot) const { return sorted_[slot]; }
   int neighbors_of_slot(int slot, std::vector<int>& out) const;
   const NeighborLists& lists() const { return lists_; }
-  // Whether the scan of an unwrapped run may test eight candidates at once with AVX-512 where the processor
-  // has it (on by default). The lists are the same either way: the same subtractions, products and sums in
-  // the same order, no fused multiply-add, candidates kept in order. Off: for tests.
-  static void allow_simd(bool on);
   int agents() const { return lists_.agents(); }
   std::span<const int> neighbors(int i) const { return lists_.neighbors(i); }
 
