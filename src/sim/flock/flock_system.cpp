@@ -15,7 +15,11 @@
 namespace kf {
 
 FlockSystem::FlockSystem(const FlockSpec& spec, double h, int steps, unsigned seed, double h_ref)
-    : spec_(spec), h_(h), seed_(seed), masses_(VecX::Constant(spec.agents, spec.mass)), neighbor_forces_(spec) {
+    : spec_(spec),
+      h_(h),
+      seed_(seed),
+      masses_(VecX::Constant(spec.agents, spec.mass)),
+      neighbor_forces_(spec) {
   if (spec.wander.strength > 0) {
     const WanderParams w{spec.wander.strength, spec.wander.correlation_steps, seed, h_ref > 0 ? h / h_ref : 1.0};
     local_forces_.push_back(std::make_unique<WanderForce>(w, spec.agents, steps));
@@ -26,6 +30,8 @@ FlockSystem::FlockSystem(const FlockSpec& spec, double h, int steps, unsigned se
   if (spec.implicit_damping) q_.assign(spec.agents, 0.0);
   motion_.resize(spec.agents);
   adjoint_.resize(spec.agents);
+  neighbor_terms_.resize(spec.agents);
+  neighbor_transposed_.resize(spec.agents);
 }
 
 std::size_t FlockSystem::record_bytes_estimate() const {
@@ -82,14 +88,18 @@ void FlockSystem::size_record(FlockRecord& r) const {
   }
 }
 
-Planar FlockSystem::neighbor_force(FlockRecord& r, int k, int i, double& damping) const {
-  damping = 0;
-  if (!neighbor_forces_.any()) {
-    r.offset[i] = Planar{};
-    r.b[i] = 1.0;
-    return Planar{};
-  }
-  return neighbor_forces_.force(motion_.data(), slot_neighbors(k), k, r.offset[i], r.b[i], damping);
+void FlockSystem::neighbor_pass(FlockRecord& r) {
+  parallel_agents(spec_.agents, [&](int k) {
+    NeighborTerms& t = neighbor_terms_[k];
+    t.damping = 0;
+    if (!neighbor_forces_.any()) {
+      r.offset[k] = Planar{};
+      r.b[k] = 1.0;
+      t.force = Planar{};
+      return;
+    }
+    t.force = neighbor_forces_.force(motion_.data(), slot_neighbors(k), k, r.offset[k], r.b[k], t.damping);
+  });
 }
 
 bool FlockSystem::stable_velocity_update(int n) {
@@ -117,8 +127,8 @@ void FlockSystem::pack_adjoint(const FlockRecord& r, const VecX& y, const std::v
   parallel_agents(spec_.agents, [&](int k) {
     const int i = grid_.agent_at(k);
     const AgentMotion& m = motion_[k];
-    adjoint_[k] = {m.x,          m.z,           m.vx,          m.vz,       y[3 * i], y[3 * i + 2],
-                   r.offset[i].x, r.offset[i].z, c / r.b[i], q ? (*q)[i] : 0.0};
+    adjoint_[k] = {m.x,          m.z,           m.vx,          m.vz,       y[3 * i],
+                   y[3 * i + 2], r.offset[k].x, r.offset[k].z, c / r.b[k], q ? (*q)[i] : 0.0};
   });
 }
 
@@ -154,15 +164,14 @@ bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
   index(x, v);
   x_next.resize(dof());
   v_next.resize(dof());
+  neighbor_pass(r);
   const double drag = std::max(spec_.drag.strength, 0.0);
-  parallel_agents(spec_.agents, [&](int k) {
-    const int i = agent(k);
+  parallel_agents(spec_.agents, [&](int i) {
+    const NeighborTerms& t = neighbor_terms_[slot(i)];
     Vec3 f = seg(u, i) + local_force(n, v, i);
-    double damping;
-    const Planar fn = neighbor_force(r, k, i, damping);
-    const double a = overshoot_[i] = h_ * (damping + drag) / masses_[i];
-    f.x() += fn.x;
-    f.z() += fn.z;
+    const double a = overshoot_[i] = h_ * (t.damping + drag) / masses_[i];
+    f.x() += t.force.x;
+    f.z() += t.force.z;
     Vec3 v1;
     if (spec_.implicit_damping) {
       r.force[i] = {f.x(), f.z()};
@@ -181,16 +190,21 @@ bool FlockSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
   return x_next.allFinite() && v_next.allFinite() && (spec_.implicit_damping || stable_velocity_update(n));
 }
 
-void FlockSystem::transpose_apply(int n, const VecX& x, const VecX& v, const VecX& y, int k, int j, Vec3& kt,
-                                  Vec3& dt, bool summed_weights) const {
-  kt.setZero();
-  dt.setZero();
-  if (neighbor_forces_.any()) {
-    Planar kp, dp;
-    neighbor_forces_.transpose_apply(adjoint_.data(), slot_neighbors(k), k, kp, dp, summed_weights);
-    kt = Vec3(kp.x, 0, kp.z);
-    dt = Vec3(dp.x, 0, dp.z);
-  }
+void FlockSystem::transposed_pass(bool summed_weights) {
+  parallel_agents(spec_.agents, [&](int k) {
+    NeighborTransposed& t = neighbor_transposed_[k];
+    if (!neighbor_forces_.any()) {
+      t = NeighborTransposed{};
+      return;
+    }
+    neighbor_forces_.transpose_apply(adjoint_.data(), slot_neighbors(k), k, t.kt, t.dt, summed_weights);
+  });
+}
+
+void FlockSystem::transpose_apply(int n, const VecX& x, const VecX& v, const VecX& y, int j, Vec3& kt, Vec3& dt) const {
+  const NeighborTransposed& t = neighbor_transposed_[slot(j)];
+  kt = Vec3(t.kt.x, 0, t.kt.z);
+  dt = Vec3(t.dt.x, 0, t.dt.z);
   // Local forces only through their interface, so a new one cannot drop out of the adjoint.
   const FlockState s{n, x, v, kNoLists};
   for (const auto& force : local_forces_) {
@@ -210,10 +224,10 @@ void FlockSystem::step_adjoint(int n, const VecX& x, const VecX& v, const VecX&,
   xhat.resize(dof());
   vhat.resize(dof());
   uhat.resize(dof());
-  parallel_agents(p, [&](int k) {
-    const int j = agent(k);
+  transposed_pass(spec_.implicit_damping);
+  parallel_agents(p, [&](int j) {
     Vec3 kt, dt;
-    transpose_apply(n, x, v, y_, k, j, kt, dt, spec_.implicit_damping);
+    transpose_apply(n, x, v, y_, j, kt, dt);
     const Vec3 yj = seg(y_, j);
     Vec3 xh = seg(xhat1, j) + h_ * kt;
     Vec3 vh = seg(vhat1, j) + h_ * seg(xhat1, j) + h_ * dt;  // s_j + h (D^T M^-1 s)_j
@@ -229,14 +243,13 @@ void FlockSystem::forces(int n, const VecX& x, const VecX& v, VecX& f) {
   check_size(x, v);
   size_record(scratch_);
   index(x, v);
+  neighbor_pass(scratch_);
   f.resize(dof());
-  parallel_agents(spec_.agents, [&](int k) {
-    const int i = agent(k);
+  parallel_agents(spec_.agents, [&](int i) {
+    const NeighborTerms& t = neighbor_terms_[slot(i)];
     Vec3 fi = local_force(n, v, i);
-    double damping;
-    const Planar fn = neighbor_force(scratch_, k, i, damping);
-    fi.x() += fn.x;
-    fi.z() += fn.z;
+    fi.x() += t.force.x;
+    fi.z() += t.force.z;
     seg(f, i) = fi;
   });
 }
@@ -245,17 +258,14 @@ void FlockSystem::apply_KT_DT(int n, const VecX& x, const VecX& v, const VecX& y
   check_size(x, v);
   size_record(scratch_);
   index(x, v);
-  parallel_agents(spec_.agents, [&](int k) {  // centering quantities
-    double damping;
-    neighbor_force(scratch_, k, agent(k), damping);
-  });
+  neighbor_pass(scratch_);  // centering quantities
   pack_adjoint(scratch_, y);
+  transposed_pass(false);
   KTy.resize(dof());
   DTy.resize(dof());
-  parallel_agents(spec_.agents, [&](int k) {
-    const int j = agent(k);
+  parallel_agents(spec_.agents, [&](int j) {
     Vec3 kt, dt;
-    transpose_apply(n, x, v, y, k, j, kt, dt, false);
+    transpose_apply(n, x, v, y, j, kt, dt);
     seg(KTy, j) = kt;
     seg(DTy, j) = dt;
   });

@@ -10,10 +10,10 @@
 // which multiplies v_i by 1/(1 + a_i) where the explicit step multiplies it by 1 - a_i: stable however
 // densely agents pack. Its adjoint is the explicit one with M^-1 s replaced by y_i = s_i / (m_i (1 + a_i)),
 // plus, since a_i depends on x through S_i, xhat_j += h sum_i q_i dS_i/dx_j with
-// q_i = -(y_i . (f_i + u_i)) h c / (m_i (1 + a_i)); f_i + u_i and 1 + a_i come from the step's record. The three neighbour forces run fused in one
-// pass over each agent's whole list (NeighborForces), each agent summing its own pair terms in its list's
-// order, so results do not depend on the thread count; wander and drag are per-agent terms. A pair's terms
-// are computed by both of its agents: at a bunched crowd's hundreds of neighbours, storing them once and
+// q_i = -(y_i . (f_i + u_i)) h c / (m_i (1 + a_i)); f_i + u_i and 1 + a_i come from the step's record. The three
+// neighbour forces run fused in one pass over each agent's whole list (NeighborForces), each agent summing its own pair
+// terms in its list's order, so results do not depend on the thread count; wander and drag are per-agent terms. A
+// pair's terms are computed by both of its agents: at a bunched crowd's hundreds of neighbours, storing them once and
 // reading them back twice moved more memory than computing them again costs.
 // The forward step records the centering quantities it found (FlockRecord, the step's tape entry); its
 // adjoint repeats the neighbour search at the step's state (the same lists, bit for bit) rather than
@@ -35,15 +35,17 @@
 namespace kf {
 
 // What a flock step found at its state that its adjoint cannot cheaply find again: the centering quantities
-// (offset m_i - x_i in the ground plane, m, and b_i; p each).
-// With implicit damping also each agent's total force f_i + u_i and 1 + a_i.
+// (offset m_i - x_i in the ground plane, m, and b_i; p each, in the slot order of the step's state, which
+// its adjoint finds again). With implicit damping also each agent's total force f_i + u_i and 1 + a_i (per
+// agent).
 struct FlockRecord final : StepRecord {
   std::vector<Planar> offset;
   std::vector<double> b;
   std::vector<Planar> force;
   std::vector<double> divisor;
   std::size_t bytes() const {
-    return (offset.capacity() + force.capacity()) * sizeof(Planar) + (b.capacity() + divisor.capacity()) * sizeof(double);
+    return (offset.capacity() + force.capacity()) * sizeof(Planar) +
+           (b.capacity() + divisor.capacity()) * sizeof(double);
   }
 };
 
@@ -80,13 +82,15 @@ class FlockSystem final : public System {
   // Sorts the agents at x into the grid's slots and packs motion_ in slot order (nothing without
   // neighbour forces: then slot k is agent k).
   void index(const VecX& x, const VecX& v);
-  int agent(int k) const { return neighbor_forces_.any() ? grid_.agent_at(k) : k; }
+  int slot(int i) const { return neighbor_forces_.any() ? grid_.slot_of(i) : i; }
   // The slots of slot k's neighbours, in this thread's work space (valid until its next call).
   std::span<int> slot_neighbors(int k) const;
   void size_record(FlockRecord& r) const;
-  // Forward neighbour pass for the agent i in slot k (motion_ packed): its force, r's offset_i and b_i, and
-  // matching's damping of i's own velocity (N/(m/s)).
-  Planar neighbor_force(FlockRecord& r, int k, int i, double& damping) const;
+  // Forward neighbour pass over the slots (motion_ packed): each slot's neighbour force and matching's
+  // damping of its own velocity (neighbor_terms_), and r's offset and b. The per-agent work then runs in
+  // agent order, reading one slot's terms, where reading each agent's vectors in slot order would miss the
+  // cache at every one of them.
+  void neighbor_pass(FlockRecord& r);
   // The explicit step's velocity update multiplies agent i's own velocity by 1 - h (c sum_j w_ij + drag)/m_i
   // (the diagonal of I + h M^-1 D). At 2 or more that factor is -1 or less, and since the diagonal entry of
   // a symmetric matrix lies within its eigenvalues, I + h M^-1 D then has an eigenvalue of -1 or less: the
@@ -99,10 +103,11 @@ class FlockSystem final : public System {
   // The adjoint's y = M^-1 s (divided by 1 + a_i with implicit damping) and, with implicit damping, q_ / h.
   void adjoint_weights(const FlockRecord& r, const VecX& xhat1, const VecX& vhat1);
   void check_size(const VecX& x, const VecX& v) const;
-  // (K^T y)_j and (D^T y)_j of all forces for the agent j in slot k (adjoint_ packed); with
-  // `summed_weights`, kt also gets the q term (adjoint_ packed with q).
-  void transpose_apply(int n, const VecX& x, const VecX& v, const VecX& y, int k, int j, Vec3& kt, Vec3& dt,
-                       bool summed_weights) const;
+  // Transposed neighbour pass over the slots (adjoint_ packed) into neighbor_transposed_; with
+  // `summed_weights`, K^T y also gets the q term (adjoint_ packed with q).
+  void transposed_pass(bool summed_weights);
+  // (K^T y)_j and (D^T y)_j of all forces for agent j (after transposed_pass).
+  void transpose_apply(int n, const VecX& x, const VecX& v, const VecX& y, int j, Vec3& kt, Vec3& dt) const;
   Vec3 local_force(int n, const VecX& v, int i) const;  // wander + drag on agent i
 
   FlockSpec spec_;
@@ -111,12 +116,23 @@ class FlockSystem final : public System {
   VecX masses_;
   NeighborForces neighbor_forces_;
   std::vector<std::unique_ptr<FlockForce>> local_forces_;  // per-agent terms: wander, drag
-  NeighborGrid grid_;    // the state being stepped or adjoined, sorted into slots
-  std::vector<AgentMotion> motion_;    // that state, packed in slot order (p)
-  std::vector<AgentAdjoint> adjoint_;  // the same with y and the centering quantities (p)
-  FlockRecord scratch_;  // forces() and apply_KT_DT
-  VecX y_;  // M^-1 s in the adjoint step
-  std::vector<double> q_;  // q_i / h in the adjoint step with implicit damping (p)
+  NeighborGrid grid_;                                      // the state being stepped or adjoined, sorted into slots
+  std::vector<AgentMotion> motion_;                        // that state, packed in slot order (p)
+  std::vector<AgentAdjoint> adjoint_;                      // the same with y and the centering quantities (p)
+  // Per slot: the neighbour force (N) and matching's own-velocity damping (N/(m/s)) of the forward pass, and
+  // the neighbour terms' (K^T y, D^T y) of the transposed one.
+  struct NeighborTerms {
+    Planar force;
+    double damping = 0;
+  };
+  struct NeighborTransposed {
+    Planar kt, dt;
+  };
+  std::vector<NeighborTerms> neighbor_terms_;
+  std::vector<NeighborTransposed> neighbor_transposed_;
+  FlockRecord scratch_;            // forces() and apply_KT_DT
+  VecX y_;                         // M^-1 s in the adjoint step
+  std::vector<double> q_;          // q_i / h in the adjoint step with implicit damping (p)
   std::vector<double> overshoot_;  // per agent, the last step's h (c sum w + drag)/m (p)
   int unstable_step_ = -1;         // the last step refused as unstable (-1: none), and its largest overshoot
   double unstable_overshoot_ = 0;

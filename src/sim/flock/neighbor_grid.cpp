@@ -127,6 +127,7 @@ void NeighborGrid::size_for(int p) {
   bucket_start_.assign(buckets + 1, 0);
   bucket_cursor_.assign(buckets, 0);
   sorted_.assign(p, 0);
+  slot_of_agent_.assign(p, 0);
   sorted_cx_.assign(p, 0);
   sorted_cz_.assign(p, 0);
   sorted_px_.assign(p, 0.0);
@@ -174,6 +175,7 @@ void NeighborGrid::sort_into_buckets(const VecX& x, double radius, int p) {
   for (int i = 0; i < p; ++i) {
     const int s = bucket_cursor_[bucket_of_agent_[i]]++;
     sorted_[s] = i;
+    slot_of_agent_[i] = s;
     sorted_cx_[s] = cell_x_[i];
     sorted_cz_[s] = cell_z_[i];
     sorted_px_[s] = x[3 * i];

@@ -37,6 +37,7 @@ class NeighborGrid {
   // many. A pass over agents' data packed in slot order then reads neighbours close together in memory.
   void index(const VecX& x, double radius);
   int agent_at(int slot) const { return sorted_[slot]; }
+  int slot_of(int agent) const { return slot_of_agent_[agent]; }
   int neighbors_of_slot(int slot, std::vector<int>& out) const;
   const NeighborLists& lists() const { return lists_; }
   int agents() const { return lists_.agents(); }
@@ -64,18 +65,19 @@ class NeighborGrid {
   template <bool kWrapped>
   int gather_run(int k, int s, int e, int64_t cx0, int64_t cz, double r2, int cap, int* out, int n) const;
 
-  double r2_ = 0;    // squared radius of the last index
-  int buckets_ = 0;  // a power of two, at least 16
-  int64_t origin_x_ = 0, origin_z_ = 0;  // cell (origin_x_, origin_z_) is bucket 0
+  double r2_ = 0;                            // squared radius of the last index
+  int buckets_ = 0;                          // a power of two, at least 16
+  int64_t origin_x_ = 0, origin_z_ = 0;      // cell (origin_x_, origin_z_) is bucket 0
   uint64_t column_mask_ = 0, row_mask_ = 0;  // columns - 1, rows - 1 (columns x rows = buckets_)
-  int row_shift_ = 0;  // log2(columns)
-  bool wrapped_ = false;  // some bucket holds more than one cell of the box
-  std::vector<int64_t> cell_x_, cell_z_;  // per agent
-  std::vector<int> bucket_of_agent_;      // per agent
-  std::vector<int> bucket_start_;         // buckets + 1
-  std::vector<int> bucket_cursor_;        // buckets
+  int row_shift_ = 0;                        // log2(columns)
+  bool wrapped_ = false;                     // some bucket holds more than one cell of the box
+  std::vector<int64_t> cell_x_, cell_z_;     // per agent
+  std::vector<int> bucket_of_agent_;         // per agent
+  std::vector<int> bucket_start_;            // buckets + 1
+  std::vector<int> bucket_cursor_;           // buckets
   // Per slot of the bucket order: the agent, its cell and its x and z.
   std::vector<int> sorted_;
+  std::vector<int> slot_of_agent_;  // its inverse
   std::vector<int64_t> sorted_cx_, sorted_cz_;
   std::vector<double> sorted_px_, sorted_pz_;
   std::vector<int> count_;  // neighbours per agent
