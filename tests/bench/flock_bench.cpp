@@ -9,14 +9,16 @@
 namespace {
 
 struct FlockFixture {
-  // density: agents per unit area over the default (~1 per m^2).
+  // density: agents per unit area over the default (~1 per m^2). A spawn disc holds agents no closer than
+  // the avoidance radius allows, so a denser crowd is the default one drawn together about its centre.
   explicit FlockFixture(int agents, double density = 1) {
     kf::FlockSpec spec;
     spec.agents = agents;
-    spec.spawn.radius = std::sqrt(agents / M_PI / density) * 1.05;
+    spec.spawn.radius = std::sqrt(agents / M_PI) * 1.05;
     spec.spawn.velocity = kf::Vec3(1, 0, 0);
     sys = std::make_unique<kf::FlockSystem>(spec, 1.0 / 30, 100, 1);
     sys->initial_state(x, v);
+    x /= std::sqrt(density);
     u = kf::VecX::Zero(x.size());
     xhat1 = kf::VecX::Constant(x.size(), 0.1);
     vhat1 = kf::VecX::Constant(x.size(), -0.2);
