@@ -103,5 +103,12 @@ TEST(FlockSpawn, FillsTheDiscWithoutCloseAgents) {
   }
 }
 
+TEST(FlockSpawn, RefusesADiscTooSmallForItsAgents) {
+  FlockSpec spec;
+  spec.agents = 200;
+  spec.spawn.radius = 1;  // holds a handful at the minimum distance
+  EXPECT_THROW(spawn_positions(spec, 11), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace kf

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -32,9 +34,13 @@ VecX spawn_positions(const FlockSpec& spec, unsigned seed) {
     for (long c = -n; c <= n; ++c)
       if (double(a * a + c * c) * s * s <= inner * inner) points.emplace_back(a * a + c * c, a, c);
   std::sort(points.begin(), points.end());
+  // The parser refuses such a disc; a spec built in code must not stack the surplus agents on one point.
+  if (long(points.size()) < long(p))
+    throw std::invalid_argument("spawn_positions: a disc of radius " + std::to_string(R) + " m holds " +
+                                std::to_string(points.size()) + " of " + std::to_string(p) + " agents");
 
   VecX x = VecX::Zero(3 * p);
-  for (int i = 0; i < p && i < int(points.size()); ++i) {
+  for (int i = 0; i < p; ++i) {
     const auto [r2, a, c] = points[i];
     const uint64_t h = mix64(mix64(uint64_t(seed) ^ 0x5F1A7E5EEDULL) ^ uint64_t(i));
     const double angle = 2 * M_PI * unit_double(h), rho = jitter * std::sqrt(unit_double(mix64(h)));
