@@ -69,6 +69,8 @@ void add_flock_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>&
               "keep the scene's coverage terms (shapes filled); results in flock_crowd_coverage.csv and its plots");
   w->add_flag("--crowd-stop-when-reached", o->crowd.stop_when_reached,
               "stop each run at its first evaluation that meets both shapes (optimizer.stop_when_reached)");
+  w->add_flag("--crowd-scale-weights", o->crowd.scale_weights,
+              "scale every keyframe's weight by sqrt(agents / the scene's agents) too (runs named square-N-weighted)");
   w->add_option("--crowd-budget", o->crowd.budget_gb, "memory budget (GB) of those runs")
       ->capture_default_str()->check(CLI::Range(1e-6, 1e6));
 }

@@ -27,7 +27,8 @@ namespace {
 
 // The scene file `base` with `agents` agents: spawn disc (centre and radius) and every shape's polygon
 // scaled by sqrt(agents / base agents) about the origin, so the density stays the figure's; coverage terms
-// dropped unless kept (their radius and spacing stay, so the samples grow with the area like the agents).
+// dropped unless kept (their radius and spacing stay, so the samples grow with the area like the agents),
+// keyframe weights scaled by the same factor when asked.
 // The duration stays, so a larger crowd rushes farther and packs tighter than the explicit step follows
 // (100,000 agents overshoot by 2.5): every size takes its damping implicitly, 200 agents as well.
 nlohmann::json scaled_scene(const nlohmann::json& base, int agents, const CrowdSweepOptions& o) {
@@ -41,10 +42,13 @@ nlohmann::json scaled_scene(const nlohmann::json& base, int agents, const CrowdS
     for (auto& c : spawn["center"]) c = c.get<double>() * k;
   if (o.stop_when_reached) s["optimizer"]["stop_when_reached"] = true;
   for (auto& objective : s["objectives"]) {
+    if (o.scale_weights) objective["weight"] = objective.value("weight", 1.0) * k;
     if (objective.contains("polygon"))
       for (auto& pt : objective["polygon"])
         for (auto& c : pt) c = c.get<double>() * k;
     if (!o.coverage) objective.erase("coverage");
+    else if (o.scale_weights && objective.contains("coverage"))
+      objective["coverage"]["weight"] = objective["coverage"].value("weight", 0.0) * k;
   }
   return s;
 }
@@ -123,7 +127,8 @@ struct CrowdPoint {
 CrowdPoint run_crowd_point(const nlohmann::json& base, int agents, double max_gb, const CrowdSweepOptions& o,
                            const std::filesystem::path& work, const std::filesystem::path& self) {
   const std::string name = "square-" + std::to_string(agents) + (o.coverage ? "-coverage" : "") +
-                           (o.stop_when_reached ? "-reached" : "") + (max_gb > 0 ? "-budget" : "");
+                           (o.stop_when_reached ? "-reached" : "") + (o.scale_weights ? "-weighted" : "") +
+                           (max_gb > 0 ? "-budget" : "");
   const auto scene = work / (name + ".json");
   const nlohmann::json scaled = scaled_scene(base, agents, o);
   write_file_atomic(scene, scaled.dump(1) + "\n");

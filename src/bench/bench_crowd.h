@@ -21,6 +21,10 @@ struct CrowdSweepOptions {
   // Each run stops at its first evaluation that meets both shapes (optimizer.stop_when_reached); the runs
   // are then named square-N-reached.
   bool stop_when_reached = false;
+  // Every keyframe's weight scaled by sqrt(agents / base agents) as well: the distances to travel grow with
+  // the shapes, so the effort of the last step into a shape grows with them while a shape's penalty for a
+  // given miss does not; the runs are then named square-N-weighted.
+  bool scale_weights = false;
 };
 
 // Writes <out>/flock_crowd.csv, flock_crowd_time.png, flock_crowd_memory.png (flock_crowd_coverage.* with

@@ -161,17 +161,23 @@ TEST_F(GradcheckBenchCli, TinyFlockBenchWritesItsCsvPlotAndSummary) {
   std::ifstream dropped(dir_ / "b/crowd/square-40.json");
   EXPECT_EQ(nlohmann::json::parse(dropped)["objectives"][0].count("coverage"), 0u);
 
-  // With coverage kept: its own table, the scaled scenes keep the terms.
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir_ / "b/crowd/square-40.json"))["objectives"][0]["weight"], 1);
+
+  // With coverage kept and the weights scaled: its own table, the scaled scenes keep the terms, and every
+  // keyframe weight (coverage too) is the figure's times sqrt(40 / 200).
   const auto c = run_keyframe("bench --only flock --agents 20 --flock-frames 5 --flock-evaluations 1 --out c "
                               "--crowd-scene " KEYFRAME_SOURCE_DIR "/scenes/square.json --crowd-agents 40 "
-                              "--crowd-evaluations 2 --crowd-coverage",
+                              "--crowd-evaluations 2 --crowd-coverage --crowd-scale-weights",
                               dir_);
   ASSERT_EQ(c.code, kExitOk) << c.output;
   EXPECT_TRUE(std::filesystem::exists(dir_ / "c/flock_crowd_coverage.csv"));
   EXPECT_TRUE(std::filesystem::exists(dir_ / "c/flock_crowd_coverage_time.png"));
   EXPECT_FALSE(std::filesystem::exists(dir_ / "c/flock_crowd.csv"));
-  std::ifstream kept(dir_ / "c/crowd/square-40-coverage.json");
-  EXPECT_GT(nlohmann::json::parse(kept)["objectives"][0]["coverage"]["weight"].get<double>(), 0);
+  const auto kept = nlohmann::json::parse(std::ifstream(dir_ / "c/crowd/square-40-coverage-weighted.json"));
+  for (const auto& objective : kept["objectives"]) {
+    EXPECT_DOUBLE_EQ(objective["weight"].get<double>(), std::sqrt(0.2));
+    EXPECT_DOUBLE_EQ(objective["coverage"]["weight"].get<double>(), 0.3 * std::sqrt(0.2));
+  }
 }
 
 // The solver sweep on two tiny sheets: one column triple per solver and thread count, every cell measured
@@ -194,8 +200,11 @@ TEST_F(GradcheckBenchCli, TinySolverBenchHasAColumnPerSolverAndRefusesUnknownNam
     ++rows;
     std::stringstream ss(line);
     std::string cell;
-    for (int c = 0; std::getline(ss, cell, ','); ++c)
-      if (c >= 2) EXPECT_GT(std::stod(cell), 0) << line;
+    for (int c = 0; std::getline(ss, cell, ','); ++c) {
+      if (c >= 2) {
+        EXPECT_GT(std::stod(cell), 0) << line;
+      }
+    }
   }
   EXPECT_EQ(rows, 2);
   EXPECT_FALSE(std::filesystem::exists(dir_ / "s/solver_motion.csv"));
