@@ -75,8 +75,8 @@ bool Problem::objective_of_rollout(const VecX& z, VecX* grad, const StepControl&
     breakdown_.emplace_back(terms_[k]->name() + "@" + std::to_string(terms_[k]->frame()), g);
     phi += g;
   }
-  VecX dz_effort = VecX::Zero(size());
-  const double e = controls_.effort(z, dz_effort);
+  dz_effort_.setZero(size());
+  const double e = controls_.effort(z, dz_effort_);
   breakdown_.emplace_back("effort", e);
   phi += e;
   if (!std::isfinite(phi)) return false;
@@ -85,7 +85,7 @@ bool Problem::objective_of_rollout(const VecX& z, VecX* grad, const StepControl&
   backward(sys_, rollout_, u_at, *this, [&](int n, const VecX& uhat) { controls_.add_step_gradient(n, uhat, *grad); },
            dx0_, dv0_, controls_.first_step());
   controls_.gather_initial_velocity(dv0_, *grad);
-  *grad += dz_effort;
+  *grad += dz_effort_;
   return grad->allFinite();
 }
 

@@ -77,6 +77,7 @@ class Problem : public StateCost {
   int checkpoint_every_ = 0;
   std::size_t memory_budget_ = 0;
   VecX dx0_, dv0_;
+  VecX dz_effort_;  // the effort's gradient, kept: a fresh vector of every control faulted in its pages each time
   Rollout rollout_;
   bool diverged_ = false;
   bool have_good_ = false;
