@@ -70,7 +70,7 @@ void add_flock_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>&
   w->add_flag("--crowd-stop-when-reached", o->crowd.stop_when_reached,
               "stop each run at its first evaluation that meets both shapes (optimizer.stop_when_reached)");
   w->add_flag("--crowd-scale-weights", o->crowd.scale_weights,
-              "scale every keyframe's weight by sqrt(agents / the scene's agents) too (runs named square-N-weighted)");
+              "scale every keyframe's weight by sqrt(agents / the scene's agents) too; results in flock_crowd_weighted.csv");
   w->add_option("--crowd-budget", o->crowd.budget_gb, "memory budget (GB) of those runs")
       ->capture_default_str()->check(CLI::Range(1e-6, 1e6));
 }

@@ -234,7 +234,9 @@ nlohmann::json bench_crowd(const CrowdSweepOptions& o, const std::filesystem::pa
                       {"evaluation_seconds", p.evaluation_s}, {"report", p.report}});
     fit.add(p);
   }
-  return write_crowd_results(t, fit, points, o.coverage ? "flock_crowd_coverage" : "flock_crowd", out);
+  const std::string stem =
+      std::string(o.coverage ? "flock_crowd_coverage" : "flock_crowd") + (o.scale_weights ? "_weighted" : "");
+  return write_crowd_results(t, fit, points, stem, out);
 }
 
 }  // namespace kf

@@ -23,13 +23,13 @@ struct CrowdSweepOptions {
   bool stop_when_reached = false;
   // Every keyframe's weight scaled by sqrt(agents / base agents) as well: the distances to travel grow with
   // the shapes, so the effort of the last step into a shape grows with them while a shape's penalty for a
-  // given miss does not; the runs are then named square-N-weighted.
+  // given miss does not; the runs are then named square-N-weighted, the results flock_crowd_weighted.*.
   bool scale_weights = false;
 };
 
 // Writes <out>/flock_crowd.csv, flock_crowd_time.png, flock_crowd_memory.png (flock_crowd_coverage.* with
-// coverage kept) and the runs under <out>/crowd/
-// (`self` is this executable). Points run in the order given, budgeted ones after the others.
+// coverage kept, *_weighted.* with the weights scaled) and the runs under <out>/crowd/ (`self` is this
+// executable). Points run in the order given, budgeted ones after the others.
 nlohmann::json bench_crowd(const CrowdSweepOptions& o, const std::filesystem::path& out,
                            const std::filesystem::path& self);
 

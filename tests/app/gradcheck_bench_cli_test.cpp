@@ -170,8 +170,8 @@ TEST_F(GradcheckBenchCli, TinyFlockBenchWritesItsCsvPlotAndSummary) {
                               "--crowd-evaluations 2 --crowd-coverage --crowd-scale-weights",
                               dir_);
   ASSERT_EQ(c.code, kExitOk) << c.output;
-  EXPECT_TRUE(std::filesystem::exists(dir_ / "c/flock_crowd_coverage.csv"));
-  EXPECT_TRUE(std::filesystem::exists(dir_ / "c/flock_crowd_coverage_time.png"));
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "c/flock_crowd_coverage_weighted.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "c/flock_crowd_coverage_weighted_time.png"));
   EXPECT_FALSE(std::filesystem::exists(dir_ / "c/flock_crowd.csv"));
   const auto kept = nlohmann::json::parse(std::ifstream(dir_ / "c/crowd/square-40-coverage-weighted.json"));
   for (const auto& objective : kept["objectives"]) {
