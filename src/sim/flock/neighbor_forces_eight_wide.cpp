@@ -1,7 +1,8 @@
 // NeighborForces' pair terms eight neighbours at a time with AVX-512: each lane evaluates one neighbour's
 // terms with the scalar formulas' operations in their order (neighbor_forces.cpp), terms a scalar pass would
 // skip are +0 or -0 (which leave a sum unchanged: a sum that starts at +0 never becomes -0), and the lanes are
-// then added to the agent's sums one by one in list order. So the sums are bit for bit the scalar passes'.
+// then added to the agent's sums one by one in list order (a chunk whose lanes are all off for a term adds
+// none). So the sums are bit for bit the scalar passes'.
 #include "sim/flock/flock_simd.h"
 
 #ifdef KF_FLOCK_AVX512
@@ -134,14 +135,18 @@ KF_EIGHT_WIDE void NeighborForces::forward_eight_wide(const AgentMotion* a, std:
     const V w_c = same_mc_ ? w_m : kernel8(r2, inv_rc2_, in_c).w;
     store_pairs(mul_in(in_c, w_c, px), mul_in(in_c, w_c, pz), c);
     _mm512_store_pd(wc, w_c);
-    const V g = _mm512_div_pd(kernel8(r2, inv_ra2_, in_a).w, root(add(r2, splat(eps2_))));
-    store_pairs(mul_in(in_a, g, px), mul_in(in_a, g, pz), av);
+    // Avoidance's radius is the smallest: a chunk of the list's outer cells often has no lane inside it, and
+    // its terms would all be +0, which leave the sum as it is.
+    if (in_a) {
+      const V g = _mm512_div_pd(kernel8(r2, inv_ra2_, in_a).w, root(add(r2, splat(eps2_))));
+      store_pairs(mul_in(in_a, g, px), mul_in(in_a, g, pz), av);
+    }
     for (int l = 0; l < k.count; ++l) {
       sum.m += pair_at(m, l);
       sum.wm += wm[l];
       sum.c += pair_at(c, l);
       sum.w += wc[l];
-      sum.a -= pair_at(av, l);
+      if (in_a) sum.a -= pair_at(av, l);
     }
   }
 }
@@ -180,18 +185,21 @@ KF_EIGHT_WIDE void NeighborForces::transposed_eight_wide(const AgentAdjoint* a, 
     store_pairs(sub_in(in_c, mul(cbi, add(mul(wc.w, yxi), mul(si, gx))), mul(cbj, sub(mul(wc.w, yxj), mul(sj, gx)))),
                 sub_in(in_c, mul(cbi, add(mul(wc.w, yzi), mul(si, gz))), mul(cbj, sub(mul(wc.w, yzj), mul(sj, gz)))),
                 kc);
-    // Avoidance: w g e + 2 (w' g - w g^3 / 2) (d . e) d, g = (r^2 + eps^2)^-1/2.
-    const Kernel8 wa = kernel8(r2, inv_ra2_, in_a);
-    const V g = _mm512_div_pd(splat(1.0), root(add(r2, splat(eps2_)))), wg = mul(wa.w, g);
-    const V sa = mul(mul(splat(2.0), sub(mul(wa.dw, g), mul(mul(mul(mul(splat(0.5), wa.w), g), g), g))),
-                     add(mul(dx, ex), mul(dz, ez)));
-    store_pairs(only(in_a, add(mul(wg, ex), mul(sa, dx))), only(in_a, add(mul(wg, ez), mul(sa, dz))), ka);
+    // Avoidance: w g e + 2 (w' g - w g^3 / 2) (d . e) d, g = (r^2 + eps^2)^-1/2; skipped like the forward's
+    // when no lane is inside its radius.
+    if (in_a) {
+      const Kernel8 wa = kernel8(r2, inv_ra2_, in_a);
+      const V g = _mm512_div_pd(splat(1.0), root(add(r2, splat(eps2_)))), wg = mul(wa.w, g);
+      const V sa = mul(mul(splat(2.0), sub(mul(wa.dw, g), mul(mul(mul(mul(splat(0.5), wa.w), g), g), g))),
+                       add(mul(dx, ex), mul(dz, ez)));
+      store_pairs(only(in_a, add(mul(wg, ex), mul(sa, dx))), only(in_a, add(mul(wg, ez), mul(sa, dz))), ka);
+    }
     for (int l = 0; l < k.count; ++l) {
       sum.km += pair_at(km, l);
       sum.dm += pair_at(dm, l);
       if constexpr (kSummedWeights) sum.kq += pair_at(kq, l);
       sum.kc += pair_at(kc, l);
-      sum.ka += pair_at(ka, l);
+      if (in_a) sum.ka += pair_at(ka, l);
     }
   }
 }
