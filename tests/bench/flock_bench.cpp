@@ -4,6 +4,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <utility>
 
 #include "sim/flock/flock_system.h"
 
@@ -48,19 +49,13 @@ void BM_FlockStepAdjoint(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }
 
+// Agents and density (over ~1 per m^2) of each case.
+void flock_cases(benchmark::internal::Benchmark* b) {
+  const std::pair<int, int> cases[] = {{200, 1}, {1000, 1}, {10000, 1}, {10000, 8}, {100000, 16}};
+  for (const auto& [agents, density] : cases) b->Args({agents, density});
+}
+
 }  // namespace
 
-BENCHMARK(BM_FlockStep)
-    ->Args({200, 1})
-    ->Args({1000, 1})
-    ->Args({10000, 1})
-    ->Args({10000, 8})
-    ->Args({100000, 16})
-    ->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_FlockStepAdjoint)
-    ->Args({200, 1})
-    ->Args({1000, 1})
-    ->Args({10000, 1})
-    ->Args({10000, 8})
-    ->Args({100000, 16})
-    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FlockStep)->Apply(flock_cases)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FlockStepAdjoint)->Apply(flock_cases)->Unit(benchmark::kMicrosecond);
