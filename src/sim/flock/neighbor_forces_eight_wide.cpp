@@ -135,8 +135,8 @@ KF_EIGHT_WIDE void NeighborForces::forward_eight_wide(const AgentMotion* a, std:
     const V w_c = same_mc_ ? w_m : kernel8(r2, inv_rc2_, in_c).w;
     store_pairs(mul_in(in_c, w_c, px), mul_in(in_c, w_c, pz), c);
     _mm512_store_pd(wc, w_c);
-    // Avoidance's radius is the smallest: a chunk of the list's outer cells often has no lane inside it, and
-    // its terms would all be +0, which leave the sum as it is.
+    // A chunk with no lane inside avoidance's radius (usually the smallest, so chunks of the list's outer
+    // cells) skips it: its terms would all be +0, which leave the sum as it is.
     if (in_a) {
       const V g = _mm512_div_pd(kernel8(r2, inv_ra2_, in_a).w, root(add(r2, splat(eps2_))));
       store_pairs(mul_in(in_a, g, px), mul_in(in_a, g, pz), av);
