@@ -34,10 +34,13 @@ int run_and_signal(const fs::path& cwd, const std::vector<std::string>& args, in
   FILE* out = ::fdopen(fds[0], "r");
   char line[4096];
   int evals = 0;
+  bool signalled = false;
   while (std::fgets(line, sizeof line, out)) {
     const std::string s(line);
     if (s.rfind("eval ", 0) == 0 || s.find(" eval ") != std::string::npos) ++evals;
-    if (signal_after > 0 && evals == signal_after) ::kill(pid, sig);
+    // Once: lines printed after it (the interruption's own) must not signal again, when the run may have
+    // left its handler and a second signal would kill it.
+    if (signal_after > 0 && evals == signal_after && !signalled) signalled = ::kill(pid, sig) == 0;
   }
   std::fclose(out);
   int status = 0;
