@@ -115,16 +115,11 @@ KF_EIGHT_WIDE inline Adjoint8 adjoint8(const AgentAdjoint* a, const Chunk& k, bo
   Adjoint8 out;
   transpose8(r, out.f);
   // (c/b, q) of agents 0-3 and 4-7, two by two (loads where gathers are slow on some cores).
+  const auto tail_of = [&](int l) { return _mm_loadu_pd(&a[k.agent[l]].c_over_b); };
   V tail[2];
-  for (int h = 0; h < 2; ++h) {
-    const AgentAdjoint* r4[4] = {&a[k.agent[4 * h]], &a[k.agent[4 * h + 1]], &a[k.agent[4 * h + 2]],
-                                 &a[k.agent[4 * h + 3]]};
-    const __m256d lo = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(&r4[0]->c_over_b)),
-                                            _mm_loadu_pd(&r4[1]->c_over_b), 1);
-    const __m256d hi = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(&r4[2]->c_over_b)),
-                                            _mm_loadu_pd(&r4[3]->c_over_b), 1);
-    tail[h] = _mm512_insertf64x4(_mm512_castpd256_pd512(lo), hi, 1);
-  }
+  for (int h = 0; h < 8; h += 4)
+    tail[h / 4] = _mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_set_m128d(tail_of(h + 1), tail_of(h))),
+                                     _mm256_set_m128d(tail_of(h + 3), tail_of(h + 2)), 1);
   out.c_over_b = _mm512_permutex2var_pd(tail[0], _mm512_setr_epi64(0, 2, 4, 6, 8, 10, 12, 14), tail[1]);
   out.q = with_q ? _mm512_permutex2var_pd(tail[0], _mm512_setr_epi64(1, 3, 5, 7, 9, 11, 13, 15), tail[1])
                  : _mm512_setzero_pd();
