@@ -227,9 +227,14 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls, int fr
   o.max_memory = b.number("max_memory", o.max_memory, 0.0, 1e6);
   o.restarts = b.integer("restarts", o.restarts, 0, 1000);
   if (b.has("throw_search")) o.throw_search = b.integer("throw_search", 0, 0, 100000);
-  o.split_schedule = b.string("split_schedule", o.split_schedule, {"held", "adaptive"});
+  o.split_schedule = b.string("split_schedule", o.split_schedule == SplitSchedule::kHeld ? "held" : "adaptive",
+                               {"held", "adaptive"}) == "held"
+                         ? SplitSchedule::kHeld
+                         : SplitSchedule::kAdaptive;
   o.adjoint = b.string("adjoint", o.adjoint, {"exact", "swap"});
-  o.strategy = b.string("strategy", o.strategy, {"auto", "single"});
+  o.strategy = b.string("strategy", o.strategy == StagingStrategy::kAuto ? "auto" : "single", {"auto", "single"}) == "auto"
+                   ? StagingStrategy::kAuto
+                   : StagingStrategy::kSingle;
   o.window_frames = b.integer("window_frames", o.window_frames, 1, 1'000'000);
   o.window_growth = b.number("window_growth", o.window_growth, 1.0, 1e300);
   if (b.has("first_step")) o.first_step = b.number("first_step", 0.0, 0.0, 1e12);
