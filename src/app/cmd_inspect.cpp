@@ -3,11 +3,32 @@
 #include <iostream>
 
 #include "app/commands.h"
+#include "core/error.h"
+#include "core/file_name.h"
 #include "scene/params.h"
 #include "scene/scene.h"
 #include "sim/character/asset_summary.h"
 
 namespace kf {
+
+namespace {
+
+void inspect(const std::string& file, bool json) {
+  const std::filesystem::path path(file);
+  if (path.extension() == ".json") {
+    ParamLog log;
+    load_scene(path, &log);
+    std::cout << log.resolved.dump(2) << "\n";
+    return;
+  }
+  const AssetSummary s = summarize_asset(path);
+  if (json)
+    std::cout << asset_json(s).dump(2) << "\n";
+  else
+    std::cout << asset_text(s);
+}
+
+}  // namespace
 
 void add_inspect_command(CLI::App& app) {
   auto* sub = app.add_subcommand(
@@ -24,18 +45,11 @@ void add_inspect_command(CLI::App& app) {
       "  keyframe inspect /usr/share/assimp/models/X/Testwuson.X\n"
       "  keyframe inspect scenes/square.json");
   sub->callback([=] {
-    const std::filesystem::path path(*file);
-    if (path.extension() == ".json") {
-      ParamLog log;
-      load_scene(path, &log);
-      std::cout << log.resolved.dump(2) << "\n";
-      return;
+    try {
+      inspect(*file, *json);
+    } catch (const InputError& e) {
+      throw InputError(printable(e.what()));  // one line, whatever the file's name or contents hold
     }
-    const AssetSummary s = summarize_asset(path);
-    if (*json)
-      std::cout << asset_json(s).dump(2) << "\n";
-    else
-      std::cout << asset_text(s);
   });
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -123,6 +124,12 @@ ObjectiveKind parse_shape(Block& b, const ObjectiveSpec&, const Scene& s) {
   k.coverage_weight = c.number("weight", 0.0, 0.0, 1e12);
   k.coverage_radius = c.number("radius", s.flock->avoidance.radius, 1e-3, 1e4);
   k.coverage_spacing = c.number("spacing", 0.5 * k.coverage_radius, 1e-3, 1e4);
+  if (const double n = region_sample_count(k.polygon, k.coverage_spacing); k.coverage_weight > 0 && !(n <= 1e5)) {
+    char msg[200];
+    std::snprintf(msg, sizeof msg, "the coverage grid over the shape's bounding box would have %.3g samples (at most "
+                  "100,000): raise \"spacing\"", n);
+    c.fail("spacing", msg);
+  }
   c.finish();
   return k;
 }
