@@ -92,6 +92,10 @@ bool simulate(System& sys, const VecX& x0, const VecX& v0, int N, const StepCont
     StepRecord& record = *r.tape[one_entry ? 0 : n];
     if (!sys.step(n, *xc, *vc, u(n), xn, vn, record)) {
       r.diverged_at = n;
+      // The kept states past the divergence hold the last finite one: no non-finite value (nor one left
+      // from an earlier rollout) reaches a trajectory written from this rollout.
+      for (int m = n + 1; m <= N; ++m)
+        if (r.kept(m)) r.x[m] = *xc, r.v[m] = *vc;
       return false;
     }
     xc = &xn;
