@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "core/ground_region.h"
 #include "core/json_depth.h"
+#include "scene/cloth_mesh_spec.h"
 #include "scene/params.h"
 #include "scene/svg_shape_spec.h"
 
@@ -15,7 +16,7 @@ namespace kf {
 
 int Scene::particles() const {
   if (flock) return flock->agents;
-  if (cloth) return cloth->nx * cloth->ny;
+  if (cloth) return cloth->particles();
   return 0;
 }
 
@@ -156,7 +157,10 @@ ObjectiveSpec parse_objective(Block b, const Scene& s) {
   o.frame = b.integer("frame", 0, s.time.frames);
   o.weight = b.number("weight", 1.0, 0.0, 1e12);
   const int p = s.particles();
-  if (b.has("particles")) {
+  if (b.has("particles") && s.cloth && b.json().at("particles").is_object()) {
+    Block region = b.child("particles");
+    o.particles = particles_in_region(region, *s.cloth);
+  } else if (b.has("particles")) {
     o.particles = b.integers("particles", 1, 0, p - 1);
   }
   for (const ObjectiveType& t : kObjectiveTypes)
@@ -275,7 +279,7 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& file, Pa
     s.flock = parse_flock_spec(b);
   } else {
     Block b = root.child("cloth");
-    s.cloth = parse_cloth_spec(b);
+    s.cloth = parse_cloth_spec(b, s.directory);
   }
   if (root.has("character")) s.character = parse_character_spec(root.child("character"), s);
   for (Block& b : root.array("objectives")) s.objectives.push_back(parse_objective(std::move(b), s));
