@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "scene/params.h"
+#include "scene/particle_selector.h"
 
 namespace kf {
 
@@ -120,6 +121,8 @@ ClothSpec parse_cloth_spec(Block& b) {
   const int p = s.particles();
   if (b.has("pins") && b.json().at("pins").is_string()) {
     s.pins = named_pin_set(b.string("pins", "none", kPinSets), s.nx, s.ny);
+  } else if (b.has("pins") && b.json().at("pins").is_object()) {
+    s.pins = parse_particle_selector(b, "pins", p, &s);  // a row, a column, a rectangle of (i, j), a region
   } else if (b.has("pins")) {
     s.pins = b.integers("pins", 0, 0, p - 1);
     std::sort(s.pins.begin(), s.pins.end());

@@ -58,7 +58,10 @@ std::string cape_scene(int frames, int n, const std::string& anchors, const std:
     "colliders": [{"type": "ground"}, {"type": "sphere"}, {"type": "torus"}, {"type": "capsule"}]},
   "character": {"file": "character.x", "anchors": )" +
          anchors + extra + R"(},
-  "objectives": [{"type": "arch", "frame": 10, "axis_point": [0, 0, 0], "radius": 1}],
+  "objectives": [{"type": "arch", "frame": 10, "axis_point": [0, 0, 0], "radius": 1},
+                 {"type": "position", "frame": 5, "particles": {"row": 0, "column": 0, "i": [0, 1], "j": [0, 1],
+                  "u": [0, 5], "v": [0, 5]}, "offset": [0, 0.1, 0], "from": "rest"},
+                 {"type": "center_of_mass", "frame": 5, "particles": "top_edge", "offset": [0, 0.1, 0]}],
   "controls": {"kind": "initial_velocity"},
   "optimizer": {"schedule": [{"substeps": 1, "controls": {"kind": "initial_rigid_velocity"}}, {"substeps": 2}],
                 "throw_search": 64}
