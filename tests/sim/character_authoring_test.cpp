@@ -113,6 +113,15 @@ TEST(CharacterAuthoring, AnimationShorterThanTheSceneWarns) {
   const Scene fits = parse_scene(scene_with("", 99), "fits.json");
   load_character(*fits.character, fits.time.frames);
   EXPECT_EQ(warnings_containing("fits.json"), 0);
+  // Past the end by round-off (30 microseconds): the same pose, no warning; by 10 ms: the warning.
+  const Scene roundoff = parse_scene(scene_with(R"(, "time": [[0, 0], [99, 3.30003]])", 99), "roundoff.json");
+  load_character(*roundoff.character, roundoff.time.frames);
+  EXPECT_EQ(warnings_containing("roundoff.json"), 0);
+  const Scene past = parse_scene(scene_with(R"(, "time": [[0, 0], [99, 3.31]])", 99), "past.json");
+  load_character(*past.character, past.time.frames);
+  EXPECT_EQ(warnings_containing("past.json: /character: the animation of BCN_Epileptic.X ends at 3.3 s, before the "
+                                "scene's last frame (frame 99 at 3.31 s): the body holds its last pose from frame 99 on"),
+            1);
 }
 
 // The sheet laid out 0.6 m below the shoulders: its pinned edge would jump there at frame 0.

@@ -29,11 +29,14 @@ Character load_character(const CharacterSpec& spec, int frames) {
     Character c(spec.file, character_options(spec));
     warn_if_frozen(spec);
     const double end = animation_time(spec, frames);
-    if (end > c.duration() + 1e-9) {
+    // A pose held for less than a millisecond past the end is the end pose: a clip's duration and the
+    // scene's frames at its fps differ by round-off (0.967 s against 29 / 30 s) without anything to say.
+    constexpr double kUnseen = 1e-3;
+    if (end > c.duration() + kUnseen) {
       // The frame where the animation's time passes its duration (time keys are piecewise linear).
       double last = frames;
       for (int f = 0; f <= frames; ++f)
-        if (animation_time(spec, f) > c.duration() + 1e-9) {
+        if (animation_time(spec, f) > c.duration() + kUnseen) {
           last = f;
           break;
         }
