@@ -92,7 +92,6 @@ struct Driver {
       rec.terms = problem.breakdown();
       rec.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
-    if (tape && gz) tape->record({z, *gz, phi, rec.seconds, rec.diverged, rec.unstable, rec.terms});
     rec.evaluation = ++result.evaluations;
     rec.phi = phi;
     rec.grad_norm = gz ? gz->norm() : 0;
@@ -103,7 +102,12 @@ struct Driver {
       if (step > 0.5 * reach) reach *= 2;
       result.phi = phi;
       result.z = z;
-      met = reached && !replayed && reached();
+      // A replayed evaluation has no rollout to judge: the stop rule's verdict was recorded with it.
+      met = replayed ? replayed->reached : reached && reached();
+    }
+    if (tape && gz) {
+      RecordedEvaluation e{z, *gz, phi, rec.seconds, rec.diverged, rec.unstable, met, rec.terms};
+      tape->record(std::move(e));
     }
     if (on_eval) on_eval(rec);
     result.history.push_back(std::move(rec));
