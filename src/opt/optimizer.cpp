@@ -152,6 +152,16 @@ void set_stop(OptimizeResult& r, StopReason reason, std::string status) {
   r.status = std::move(status);
 }
 
+// NLopt may report a forced stop as a generic failure; what stopped it is known here. A stop asked for
+// during the evaluation NLopt ended on (its line search gave up, or it converged, without asking again)
+// is an interruption too: the run stops because it was told to, whatever NLopt said.
+void settle_stop(Driver& d, const std::atomic<bool>* stop) {
+  if (stop && stop->load()) d.result.interrupted = true;
+  if (d.result.interrupted) set_stop(d.result, StopReason::kInterrupted, "interrupted");
+  else if (d.result.reached) set_stop(d.result, StopReason::kKeyframesReached, kKeyframesReached);
+  else if (d.limit_reached) set_stop(d.result, StopReason::kEvaluationLimit, status_name(nlopt::MAXEVAL_REACHED));
+}
+
 }  // namespace
 
 OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX& z0,
@@ -206,13 +216,7 @@ OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX&
       set_stop(d.result, StopReason::kLineSearchStalled,
                std::string("stopped: line search made no progress (") + e.what() + ")");
     }
-    // NLopt may report a forced stop as a generic failure; what stopped it is known here. A stop asked for
-    // during the evaluation NLopt ended on (its line search gave up, or it converged, without asking again)
-    // is an interruption too: the run stops because it was told to, whatever NLopt said.
-    if (stop && stop->load()) d.result.interrupted = true;
-    if (d.result.interrupted) set_stop(d.result, StopReason::kInterrupted, "interrupted");
-    else if (d.result.reached) set_stop(d.result, StopReason::kKeyframesReached, kKeyframesReached);
-    else if (d.limit_reached) set_stop(d.result, StopReason::kEvaluationLimit, status_name(nlopt::MAXEVAL_REACHED));
+    settle_stop(d, stop);
   }
   d.result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d.start).count();
   if (!std::isfinite(d.result.phi)) d.result.phi = problem.evaluate(d.result.z, nullptr);

@@ -223,7 +223,9 @@ void run_stage(Run& run, const std::vector<StageSpec>& stages, size_t s) {
 void run_stages(Run& run, std::vector<StageSpec>& stages, size_t first) {
   for (size_t s = first;
        s < stages.size() && !run.r.interrupted && run.r.reason != StopReason::kKeyframesReached; ++s) {
+    const size_t recorded = run.r.stages.size();
     run_stage(run, stages, s);
+    if (run.r.stages.size() == recorded) break;  // stopped before the stage's first evaluation
     if (s + 1 < stages.size() && !run.fixed_budgets)
       stages[s + 1].max_evaluations += std::max(0, stages[s].max_evaluations - run.r.stages.back().evaluations);
   }
