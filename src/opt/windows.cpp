@@ -108,7 +108,7 @@ StagePlan plan_stages(const Scene& scene) {
     if (lattice_budget > 0) plan.stages.push_back({scene.time.substeps, lattice_budget, lattice});
     plan.stages.push_back({scene.time.substeps, o.max_evaluations - rigid_budget - lattice_budget, std::nullopt});
     plan.throw_search = o.throw_search >= 0 ? o.throw_search
-                                            : automatic_throw_count(scene.cloth->nx * scene.cloth->ny, scene.time.steps());
+                                            : automatic_throw_count(scene.cloth->particles(), scene.time.steps());
     plan.why = "stages: a search over " + std::to_string(plan.throw_search) +
                " rigid throws, the best rigid throw (6 variables), a 3 x 3 lattice of initial velocities over the "
                "sheet from it, then one initial velocity per particle";

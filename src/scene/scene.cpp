@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/ground_region.h"
 #include "core/json_depth.h"
+#include "scene/cloth_mesh_spec.h"
 #include "scene/params.h"
 #include "scene/particle_selector.h"
 #include "scene/svg_shape_spec.h"
@@ -17,7 +18,7 @@ namespace kf {
 
 int Scene::particles() const {
   if (flock) return flock->agents;
-  if (cloth) return cloth->nx * cloth->ny;
+  if (cloth) return cloth->particles();
   return 0;
 }
 
@@ -219,7 +220,12 @@ ObjectiveSpec parse_objective(Block b, const Scene& s) {
   o.frame = b.integer("frame", 0, s.time.frames);
   o.weight = b.number("weight", 1.0, 0.0, 1e12);
   const int p = s.particles();
-  if (b.has("particles")) o.particles = parse_particle_selector(b, "particles", p, s.cloth ? &*s.cloth : nullptr);
+  if (b.has("particles") && s.cloth && is_rest_box(b.json().at("particles"))) {
+    Block region = b.child("particles");
+    o.particles = particles_in_region(region, *s.cloth);
+  } else if (b.has("particles")) {
+    o.particles = parse_particle_selector(b, "particles", p, s.cloth ? &*s.cloth : nullptr);
+  }
   for (const ObjectiveType& t : kObjectiveTypes)
     if (type == t.name) o.kind = t.parse(b, o, s);
   b.finish();
@@ -341,7 +347,7 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& file, Pa
     s.flock = parse_flock_spec(b);
   } else {
     Block b = root.child("cloth");
-    s.cloth = parse_cloth_spec(b);
+    s.cloth = parse_cloth_spec(b, s.directory);
   }
   if (root.has("character")) s.character = parse_character_spec(root.child("character"), s);
   for (Block& b : root.array("objectives")) s.objectives.push_back(parse_objective(std::move(b), s));

@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "sim/cloth/imperfection.h"
+#include "sim/cloth/mesh_layout.h"
 #include "sim/make_system.h"
 
 namespace kf {
@@ -47,6 +48,7 @@ AdjointKind adjoint_kind(const std::string& name) {
 namespace {
 // The grid's positions at rest (3p, metres).
 VecX rest_positions(const ClothSpec& spec) {
+  if (spec.mesh) return mesh_rest_positions(spec);
   const double dx = spec.width / (spec.nx - 1), dy = spec.height / (spec.ny - 1);
   VecX x0(3 * spec.particles());
   for (int j = 0; j < spec.ny; ++j)
@@ -73,7 +75,8 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
       colliders_(all_colliders(spec, std::move(extra_colliders))),
       assembly_(spec, x0_, colliders_),
       pins_(pins ? std::move(pins) : std::make_unique<StaticPins>()) {
-  mass_.setConstant(p_, spec.mass / p_);
+  if (spec.mesh) mass_ = mesh_masses(spec);
+  else mass_.setConstant(p_, spec.mass / p_);
   free_.assign(p_, 1);
   for (int i : spec.pins) {
     if (i < 0 || i >= p_) throw InputError("cloth: pinned particle " + std::to_string(i) + " does not exist");
@@ -95,7 +98,9 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   direct_solve_ = spec.direct_solver();
   split_x_.resize(spec.max_halvings);
   split_v_.resize(spec.max_halvings);
-  pcg_.resize(p_, preconditioner_kind(spec.cg_preconditioner, p_), spec.nx, spec.ny);
+  // Multigrid is the grid's: a mesh cloth's PCG uses IC(0) (or block Jacobi) whatever the scene asks.
+  if (spec.mesh) pcg_.resize(p_, spec.block_jacobi() ? Preconditioner::kBlockJacobi : Preconditioner::kIncompleteCholesky);
+  else pcg_.resize(p_, preconditioner_kind(spec.cg_preconditioner, p_), spec.nx, spec.ny);
   // IC(0) leaves out the bending springs' blocks: with the default stiffnesses they are a hundredth of the
   // stretch springs' and they reach two grid rows, so they made half the factor's blocks and a separator twice
   // as wide for a few per cent fewer iterations.
@@ -352,9 +357,9 @@ void ClothSystem::restore_step_context(int n, const VecX& context) { forward_sta
 std::string ClothSystem::describe() const {
   std::ostringstream os, tolerance;
   tolerance << spec_.cg_tolerance;
-  os << "cloth: " << spec_.nx << "x" << spec_.ny << " particles, " << assembly_.springs().list.size() << " springs, "
+  os << "cloth: " << (spec_.mesh ? std::to_string(p_) + " mesh" : std::to_string(spec_.nx) + "x" + std::to_string(spec_.ny)) << " particles, " << assembly_.springs().list.size() << " springs, "
      << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, "
-     << (direct_solve_ ? std::string("sparse ") + FilteredDirect::backend() : std::string("PCG (") + preconditioner_name(preconditioner_kind(spec_.cg_preconditioner, p_)) + ", tolerance " + tolerance.str() + ")") << ", " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
+     << (direct_solve_ ? std::string("sparse ") + FilteredDirect::backend() : std::string("PCG (") + preconditioner_name(spec_.mesh && !spec_.block_jacobi() ? Preconditioner::kIncompleteCholesky : preconditioner_kind(spec_.cg_preconditioner, p_)) + ", tolerance " + tolerance.str() + ")") << ", " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
   if (spec_.theta != 1) os << ", theta " << spec_.theta << " step";
   return os.str();
 }
