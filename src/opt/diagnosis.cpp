@@ -313,10 +313,10 @@ std::string untouched_cause(const std::vector<KeyframeJudgement>& keyframes) {
          "; change: raise " + untouched->name + "'s weight, or keyframe it in a scene cut at its frame first";
 }
 
-// Noise at the start explains a run that never left it; a run whose keyframe terms fell by half left it.
-std::string likely_cause(const Sensitivity& s, const RunFacts& facts, bool progress) {
+// Noise at the start explains a run that stayed near it; one whose keyframe terms fell tenfold left it.
+std::string likely_cause(const Sensitivity& s, const RunFacts& facts) {
   if (unstable_edge(facts)) return unstable_cause(facts);
-  if (s.noisy() && !progress)
+  if (s.noisy() && facts.keyframe_objective_end > 0.1 * facts.keyframe_objective_start)
     return format("cause: the objective is noise at the start (it moves by %.2g of itself under perturbations "
                   "of 1e-9): the start is a bifurcation, ",
                   s.relative_noise()) +
@@ -365,7 +365,7 @@ Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensit
   d.outcome = !d.progress ? "no_progress" : d.far ? "not_reached" : "near";
   const std::string untouched = untouched_cause(keyframes);
   d.line = verdict_head(d, facts) + miss_text(*worst) + budget + "; " +
-           (untouched.empty() ? likely_cause(s, facts, d.progress) : untouched);
+           (untouched.empty() ? likely_cause(s, facts) : untouched);
   return d;
 }
 
