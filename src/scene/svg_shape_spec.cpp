@@ -35,7 +35,7 @@ double signed_area(const std::vector<Vec2>& loop) {
 std::string read_svg_file(const Block& b, const std::filesystem::path& file) {
   const std::string shown = printable(file.string());
   const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) b.fail("file", "cannot open the SVG file " + shown + ": " + std::strerror(errno));
+  if (fd < 0) b.fail("file", "cannot open the SVG file " + shown);
   struct stat st {};
   std::string problem;
   if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) problem = ": not a regular file";

@@ -111,7 +111,8 @@ std::string child_failure(int status) {
     const char* what = sigabbrev_np(sig);
     return std::string("assimp crashed reading it (SIG") + (what ? what : std::to_string(sig).c_str()) + ")";
   }
-  return "assimp stopped reading it (exit status " + std::to_string(WEXITSTATUS(status)) + ")";
+  // An exit status: a sanitizer's report of a crash, or assimp calling exit itself.
+  return "assimp crashed reading it (exit status " + std::to_string(WEXITSTATUS(status)) + ")";
 }
 
 // The child's answer, from a fork that imports the file.
