@@ -86,6 +86,49 @@ struct ClassTally {
   std::vector<double> evaluations, seconds;
 };
 
+// One scene's optimize job, cut at the pass time, and its report (copied to out/reports/).
+struct SceneRun {
+  OptimizeOutcome outcome;
+  nlohmann::json report;
+  bool cut = false;
+  double seconds = 0;
+};
+
+SceneRun run_scene(const ReachableSweepOptions& o, const std::string& name, const std::filesystem::path& file,
+                   const std::filesystem::path& out) {
+  OptimizeOptions opt;
+  opt.out = (o.runs_dir / name).string();
+  opt.quiet = true;
+  opt.max_seconds = o.max_seconds;
+  std::cerr << "bench reachable: " << name << " (load " << load_average() << ")" << std::endl;
+  SceneRun run;
+  const auto start = std::chrono::steady_clock::now();
+  {
+    JobDeadline deadline(o.pass_seconds);
+    run.outcome = optimize_job(file, opt);
+    run.cut = deadline.fired();
+  }
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::ifstream in(run.outcome.dir / "report.json");
+  run.report = nlohmann::json::parse(in);
+  write_file_atomic(out / "reports" / (name + ".json"), run.report.dump(1) + "\n");
+  return run;
+}
+
+// reachable_classes.csv (pass rate, median evaluations, median and worst seconds a class) and its plot.
+void write_class_table(const std::map<std::string, ClassTally>& tally, int rows, const std::filesystem::path& out) {
+  CsvTable classes({"class", "scenes", "passed", "pass_rate", "median_evaluations", "median_seconds", "worst_seconds"});
+  for (const auto& [kind, c] : tally)
+    classes.add({kind, std::to_string(c.scenes), std::to_string(c.passed), fmt(double(c.passed) / c.scenes),
+                 fmt(median(c.evaluations)), fmt(median(c.seconds)),
+                 fmt(*std::max_element(c.seconds.begin(), c.seconds.end()))});
+  classes.write(out / "reachable_classes.csv");
+  if (rows > 0)
+    bar_plot_csv(out / "reachable_classes.csv", out / "reachable.png", "pass rate by class (1: every scene passed)",
+                 {classes.col("class")}, {classes.col("pass_rate")}, false);
+  std::cout << classes.excerpt(100) << std::endl;
+}
+
 }  // namespace
 
 nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesystem::path& out) {
@@ -104,23 +147,10 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
     const ReachableScene r = generate_reachable(kind, o.seed, index, false, o.scene_dir);
     write_file_atomic(file, r.scene.dump(1) + "\n");
     if (o.generate_only) continue;
-    OptimizeOptions opt;
-    opt.out = (o.runs_dir / name).string();
-    opt.quiet = true;
-    opt.max_seconds = o.max_seconds;
-    std::cerr << "bench reachable: " << name << " (load " << load_average() << ")" << std::endl;
-    const auto start = std::chrono::steady_clock::now();
-    OptimizeOutcome outcome;
-    bool cut = false;
-    {
-      JobDeadline deadline(o.pass_seconds);
-      outcome = optimize_job(file, opt);
-      cut = deadline.fired();
-    }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::ifstream in(outcome.dir / "report.json");
-    const nlohmann::json report = nlohmann::json::parse(in);
-    write_file_atomic(out / "reports" / (name + ".json"), report.dump(1) + "\n");
+    const SceneRun run = run_scene(o, name, file, out);
+    const nlohmann::json& report = run.report;
+    const bool cut = run.cut;
+    const double seconds = run.seconds;
     const nlohmann::json* worst = nullptr;
     for (const auto& k : report.at("keyframe_errors"))
       if (k.at("judged").get<bool>() &&
@@ -144,24 +174,16 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
            fmt(worst->at("miss_after").get<double>()), std::to_string(evaluations), fmt(seconds),
            cut ? "cut" : report.at("diagnosis").at("outcome").get<std::string>(), pass ? "yes" : "no"});
     t.write(out / "reachable.csv");  // after every scene: a cut-off run keeps what it measured
-    summary["diagnoses"][name] = outcome.diagnosis;
+    summary["diagnoses"][name] = run.outcome.diagnosis;
   }
   if (o.generate_only) return summary;
-  CsvTable classes({"class", "scenes", "passed", "pass_rate", "median_evaluations", "median_seconds", "worst_seconds"});
-  for (const auto& [kind, c] : tally)
-    classes.add({kind, std::to_string(c.scenes), std::to_string(c.passed), fmt(double(c.passed) / c.scenes),
-                 fmt(median(c.evaluations)), fmt(median(c.seconds)),
-                 fmt(*std::max_element(c.seconds.begin(), c.seconds.end()))});
-  classes.write(out / "reachable_classes.csv");
-  if (rows > 0)
-    bar_plot_csv(out / "reachable_classes.csv", out / "reachable.png", "pass rate by class (1: every scene passed)",
-                 {classes.col("class")}, {classes.col("pass_rate")}, false);
+  write_class_table(tally, rows, out);
   summary["load_after"] = load_average();
   summary["passed"] = passed;
   summary["scenes"] = rows;
   write_file_atomic(out / "load.txt", "load average (1, 5, 15 min) before: " + summary["load_before"].get<std::string>() +
                                           "\nafter: " + summary["load_after"].get<std::string>() + "\n");
-  std::cout << "reachable.csv: " << passed << " of " << rows << " scenes pass\n" << classes.excerpt(100) << std::endl;
+  std::cout << "reachable.csv: " << passed << " of " << rows << " scenes pass" << std::endl;
   return summary;
 }
 
