@@ -37,6 +37,13 @@ void ensure_tape(const System& sys, std::vector<std::unique_ptr<StepRecord>>& ta
   while (int(tape.size()) < n) tape.push_back(sys.new_record());
 }
 
+// The kept states past step n (whose step diverged) hold the state of step n: no non-finite value (nor
+// one left from an earlier rollout) reaches a trajectory written from a diverged rollout.
+void hold_after_divergence(Rollout& r, int n, const VecX& x, const VecX& v) {
+  for (int m = n + 1; m <= r.steps(); ++m)
+    if (r.kept(m)) r.x[m] = x, r.v[m] = v;
+}
+
 }  // namespace
 
 bool simulate(System& sys, const VecX& x0, const VecX& v0, int N, const StepControl& u, Rollout& r,
@@ -92,6 +99,7 @@ bool simulate(System& sys, const VecX& x0, const VecX& v0, int N, const StepCont
     StepRecord& record = *r.tape[one_entry ? 0 : n];
     if (!sys.step(n, *xc, *vc, u(n), xn, vn, record)) {
       r.diverged_at = n;
+      hold_after_divergence(r, n, *xc, *vc);
       return false;
     }
     xc = &xn;

@@ -1,10 +1,14 @@
 // keyframe gradcheck SCENE: the adjoint gradient against central finite differences.
+#include <sys/stat.h>
+
 #include <cmath>
 #include <iostream>
 #include <random>
 
 #include "app/commands.h"
 #include "core/error.h"
+#include "core/file_name.h"
+#include "core/warnings.h"
 #include "opt/controls_file.h"
 #include "opt/gradcheck.h"
 #include "scene/scene.h"
@@ -64,7 +68,11 @@ void run_gradcheck(const GradcheckCommandOptions& o) {
   VecX z = problem.initial_guess();
   if (!o.at.empty()) {
     int substeps = 0;
-    z = load_controls(std::filesystem::path(o.at) / "controls.bin", &substeps);
+    const std::filesystem::path file = std::filesystem::path(o.at) / "controls.bin";
+    // Opening a FIFO would wait for a writer, and a device would never end.
+    if (struct stat st {}; ::stat(file.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+      throw InputError(printable(file.string()) + ": not a regular file");
+    z = load_controls(file, &substeps);
     if (z.size() != problem.size() || substeps != scene.time.substeps)
       throw InputError(o.at + "/controls.bin: holds " + std::to_string(z.size()) + " controls at " +
                        std::to_string(substeps) + " substeps; the scene's controls are " +
@@ -76,6 +84,9 @@ void run_gradcheck(const GradcheckCommandOptions& o) {
   }
   const GradcheckResult r = gradcheck(
       problem, z, {.samples = o.samples, .eps = o.eps, .kink_tolerance = o.kink_tolerance, .seed = o.seed});
+  if (r.diverged)
+    warn(printable(o.scene) + ": the simulation diverges at these controls (step " + std::to_string(r.diverged_at) +
+         "): no gradient exists there and nothing was compared");
   nlohmann::json j = r.to_json();
   j["scene"] = scene.name;
   j["h"] = scene.time.h();

@@ -11,6 +11,9 @@
 #include "core/error.h"
 #include "core/progress.h"
 #include "core/trajectory.h"
+#include "opt/diagnosis.h"
+#include "report/figure_measures.h"
+#include "report/keyframe_lines.h"
 #include "sim/make_system.h"
 
 namespace kf {
@@ -59,20 +62,29 @@ void add_simulate_command(CLI::App& app) {
       throw InputError(scene.file.string() + ": the simulation diverged at step " + std::to_string(r.diverged_at) +
                        (why.empty() ? " (reduce the time step or the stiffness)" : ": " + why));
     }
+    const Trajectory frames = frames_of(r, scene.time, sys->particles());
+    // The dry run's measures: how far the uncontrolled motion misses each keyframe, judged as optimize
+    // judges its result, so a keyframe can be weighed before a long optimisation.
+    const nlohmann::json measures = figure_measures(scene, frames);
+    const std::vector<KeyframeJudgement> keyframes = judge_keyframes(scene, measures, measures);
     commit_run_dir(staged, [&](const fs::path& work) {
       prepare_run_dir(work, scene);
-      save_trajectory(work / "trajectory.bin", frames_of(r, scene.time, sys->particles()));
+      save_trajectory(work / "trajectory.bin", frames);
       write_body_meshes(scene, scene.time.frames + 1, work / "meshes.bin");
       nlohmann::json report = {{"scene", scene.name}, {"command", "simulate"}, {"system", forward_description(*sys)},
                                {"gradient", false},
                                {"steps", scene.time.steps()}, {"frames", scene.time.frames + 1},
                                {"simulate_seconds", secs}};
       for (const auto& [name, value] : sys->run_stats()) report["run_stats"][name] = value;
+      report["measures"] = measures;
+      report["keyframe_errors"] = nlohmann::json::array();
+      for (const auto& k : keyframes) report["keyframe_errors"].push_back(k.to_json());
       write_json(work / "report.json", report);
     });
     std::cout << "simulated " << scene.time.steps() << " steps forward (no controls, no gradient) of "
               << forward_description(*sys) << " in " << secs
               << " s -> " << (dir / "trajectory.bin").string() << "\n";
+    for (const std::string& line : keyframe_lines(scene, keyframes)) std::cout << line << "\n";
   });
 }
 

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "bench/bench_crowd.h"
+#include "bench/bench_reachable.h"
 #include "bench/bench_sweeps.h"
 #include "app/commands.h"
 #include "core/atomic_file.h"
@@ -25,6 +26,7 @@ struct BenchOptions {
   SolverSweepOptions solver;
   AdjointSweepOptions adjoint;
   RobustnessSweepOptions robustness;
+  ReachableSweepOptions reachable;
   int point_steps = 0, point_every = 0, point_resolution = 16;
 };
 
@@ -143,6 +145,25 @@ void add_adjoint_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions
       ->capture_default_str()->check(CLI::Range(0.0, 1e6));
 }
 
+void add_reachable_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
+  auto* r = sub->add_option_group("reachable suite");
+  r->add_option("--reachable-seed", o->reachable.seed, "the generator's seed")->capture_default_str();
+  r->add_option("--reachable-count", o->reachable.count, "scenes, shared over the classes")
+      ->capture_default_str()->check(CLI::Range(1, 100000));
+  r->add_option("--reachable-classes", o->reachable.classes, "only these classes")
+      ->delimiter(',')->check(CLI::IsMember(reachable_classes()));
+  r->add_option("--reachable-scenes", o->reachable.scenes, "only these scene names (\"smoke\": one a class and two more)")
+      ->delimiter(',');
+  r->add_option("--reachable-dir", o->reachable.scene_dir, "where the scene files are written")->capture_default_str();
+  r->add_option("--reachable-runs", o->reachable.runs_dir, "where each scene's run directory goes")->capture_default_str();
+  r->add_flag("--reachable-generate-only", o->reachable.generate_only, "write the scene files and stop");
+  r->add_option("--reachable-seconds", o->reachable.max_seconds,
+                "wall-time limit of each scene's optimiser stages; a scene passes only within --reachable-pass-seconds")
+      ->capture_default_str()->check(CLI::Range(0.0, 1e6));
+  r->add_option("--reachable-pass-seconds", o->reachable.pass_seconds, "a scene passes only within this wall time")
+      ->capture_default_str()->check(CLI::Range(0.0, 1e6));
+}
+
 // The option groups of the sweeps.
 void add_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
   add_cloth_sweep_options(sub, o);
@@ -150,6 +171,7 @@ void add_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
   add_memory_sweep_options(sub, o);
   add_solver_sweep_options(sub, o);
   add_adjoint_sweep_options(sub, o);
+  add_reachable_options(sub, o);
 }
 
 // --quick: smaller sweeps, except where an option was given explicitly.
@@ -184,7 +206,8 @@ void add_bench_command(CLI::App& app) {
       "checkpointing), adjoint (exact against swap on the cloth figures: gradient cost and error, keyframe error "
       "in the same wall time), solver (cloth step cost against particles per linear solver and thread count, "
       "forward and gradient, beside Blender when installed), robustness (only when named in --only: the scenes of "
-      "scenes/robustness optimised at their default settings and judged by their keyframes); writes CSV + PNG "
+      "scenes/robustness optimised at their default settings and judged by their keyframes), reachable (only when "
+      "named: generated scenes whose keyframes a variant of the scene reached, bench_reachable.h); writes CSV + PNG "
       "under --out");
   auto o = std::make_shared<BenchOptions>();
   sub->add_option("--out", o->out, "output directory")->capture_default_str();
@@ -192,7 +215,7 @@ void add_bench_command(CLI::App& app) {
                 "reduced sweep (a few minutes): substeps 1,4,16; n 16,24,32; tolerances 1e-4,1e-6,1e-8; agents "
                 "100,300,1000; steps 500..4000; fewer samples and evaluations. Options given explicitly win.");
   sub->add_option("--only", o->only, "run only these sweeps")
-      ->check(CLI::IsMember({"cloth", "flock", "memory", "adjoint", "solver", "robustness"}))
+      ->check(CLI::IsMember({"cloth", "flock", "memory", "adjoint", "solver", "robustness", "reachable"}))
       ->delimiter(',');
   add_sweep_options(sub, o);
   // The child side of the memory sweep: one gradient in a fresh process.
@@ -223,6 +246,8 @@ void add_bench_command(CLI::App& app) {
     // The suite takes up to an hour: only when named.
     if (std::find(o->only.begin(), o->only.end(), "robustness") != o->only.end())
       summary["robustness"] = bench_robustness(o->robustness, out);
+    if (std::find(o->only.begin(), o->only.end(), "reachable") != o->only.end())
+      summary["reachable"] = bench_reachable(o->reachable, out);
     write_file_atomic(out / "summary.json", summary.dump(2) + "\n");
   });
 }

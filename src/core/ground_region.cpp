@@ -86,20 +86,28 @@ Vec2 closest_point_in_polygon(const GroundRegion& region, const Vec2& q, bool* i
 
 namespace {
 
-// The outer loop's bounding box and the grid of `spacing` region_samples lays over it.
+// The outer loop's bounding box and the grid of `spacing` region_samples lays over it. The cell counts are
+// formed in double precision first: a shape of 1e9 m at a spacing of 1 mm overflows any integer.
 struct SampleGrid {
   Vec2 lo, hi;
-  int nx = 1, nz = 1;
+  double count = 1;  // nx * nz, however large
+  int nx = 1, nz = 1;  // valid when !too_many()
   SampleGrid(const std::vector<Vec2>& polygon, double spacing) : lo(polygon.front()), hi(lo) {
     for (const Vec2& p : polygon) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-    nx = std::max(1, int(std::lround((hi.x() - lo.x()) / spacing)));
-    nz = std::max(1, int(std::lround((hi.y() - lo.y()) / spacing)));
+    const double fx = std::max(1.0, std::round((hi.x() - lo.x()) / spacing));
+    const double fz = std::max(1.0, std::round((hi.y() - lo.y()) / spacing));
+    count = fx * fz;
+    if (!too_many()) nx = int(fx), nz = int(fz);
   }
-  bool too_many() const { return double(nx) * nz > kMaxRegionSamples; }
+  bool too_many() const { return !(count <= kMaxRegionSamples); }
   static constexpr double kMaxRegionSamples = 1e5;
 };
 
 }  // namespace
+
+double region_sample_count(const std::vector<Vec2>& outer, double spacing) {
+  return SampleGrid(outer, spacing).count;
+}
 
 double sample_spacing_within_limit(const GroundRegion& region, double spacing) {
   while (SampleGrid(region.outer, spacing).too_many()) spacing *= 1.05;

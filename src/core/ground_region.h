@@ -25,6 +25,8 @@ Vec2 closest_point_in_polygon(const GroundRegion& region, const Vec2& q, bool* i
 // The points of a square grid of `spacing` (cell centres, centred in the outer loop's bounding box) inside the
 // region: where a shape keyframe asks for an agent nearby. Throws InputError past 100,000 points.
 std::vector<Vec2> region_samples(const GroundRegion& region, double spacing);
+// How many cells that grid has (inside the region or not), in double precision: checked when a scene is read.
+double region_sample_count(const std::vector<Vec2>& outer, double spacing);
 // `spacing`, or the least coarser one (in 5 % steps) at which region_samples stays within its 100,000 points:
 // for measuring a region far larger than its spacing was chosen for (a crowd's shape).
 double sample_spacing_within_limit(const GroundRegion& region, double spacing);

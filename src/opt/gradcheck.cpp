@@ -9,10 +9,17 @@
 namespace kf {
 
 nlohmann::json GradcheckResult::to_json() const {
-  return {{"checked", checked},     {"kinks", kinks},         {"max_rel_error", max_rel_error},
-          {"cosine", cosine},       {"rel_error_norm", rel_error_norm}, {"fd_spread", fd_spread},
-          {"floor", floor},         {"grad_norm", grad_norm}, {"phi", phi},
-          {"eps", eps}, {"phi_noise", phi_noise}};
+  nlohmann::json j = {{"checked", checked},     {"kinks", kinks},         {"max_rel_error", max_rel_error},
+                      {"cosine", cosine},       {"rel_error_norm", rel_error_norm}, {"fd_spread", fd_spread},
+                      {"floor", floor},         {"grad_norm", grad_norm}, {"phi", phi},
+                      {"eps", eps}, {"phi_noise", phi_noise}};
+  if (diverged) {
+    for (const char* k : {"max_rel_error", "cosine", "rel_error_norm", "fd_spread", "floor", "grad_norm", "phi_noise"})
+      j[k] = nullptr;
+    j["diverged"] = true;
+    j["diverged_at_step"] = diverged_at;
+  }
+  return j;
 }
 
 namespace {
@@ -83,6 +90,11 @@ GradcheckResult gradcheck(Problem& problem, const VecX& z, const GradcheckOption
   r.eps = o.eps;
   VecX g(z.size());
   r.phi = problem.evaluate(z, &g);
+  if (problem.last_diverged()) {
+    r.diverged = true;
+    r.diverged_at = problem.rollout().diverged_at;
+    return r;
+  }
   r.grad_norm = g.norm();
   const std::vector<int> picks = pick_coordinates(g, o.samples, o.seed);
   r.phi_noise = phi_noise(problem, z, r.phi, o.seed);

@@ -39,6 +39,10 @@ struct GradcheckResult {
   double phi = 0;
   double phi_noise = 0;        // φ's round-off near z (second differences along a random direction)
   double eps = 0;
+  // The simulation diverged at z (at this step): φ is the large finite stand-in, no gradient exists and
+  // nothing was compared; the error measures are then null in to_json, not 0.
+  bool diverged = false;
+  int diverged_at = -1;
   nlohmann::json to_json() const;
 };
 
@@ -53,6 +57,7 @@ struct DifferenceEstimate {
 DifferenceEstimate extrapolated_difference(double step, const std::function<double(double)>& central,
                                            double target, double noise);
 
+// At controls under which the simulation diverges, returns with `diverged` set and nothing compared.
 GradcheckResult gradcheck(Problem& problem, const VecX& z, const GradcheckOptions& options);
 
 // The round-off σ of φ near z (φ = φ(z), already evaluated): φ along a random direction (from `seed`) at steps

@@ -58,6 +58,10 @@ Vec3 cloth_rest_position(const ClothSpec& c, int particle) {
   return c.origin + (particle % c.nx) * dx * c.u_axis + (particle / c.nx) * dy * c.v_axis;
 }
 
+bool is_rest_box(const nlohmann::json& set) {
+  return set.is_object() && (set.contains("min") || set.contains("max"));
+}
+
 std::vector<int> particles_in_region(Block& b, const ClothSpec& c) {
   const Vec3 lo = b.vec3("min"), hi = b.vec3("max");
   if ((hi - lo).minCoeff() < 0) b.fail("max", "expected every coordinate at least \"min\"'s");

@@ -11,6 +11,8 @@
 #include <memory>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "core/types.h"
 #include "scene/cloth_mesh.h"
 
@@ -23,6 +25,9 @@ std::shared_ptr<const ClothMesh> parse_cloth_mesh(Block b, const std::filesystem
 
 // A particle's rest position before any imperfection: the mesh's vertex, or its place on the grid.
 Vec3 cloth_rest_position(const ClothSpec& c, int particle);
+
+// Whether a particle set is a box of rest space ({"min", "max"}) rather than a selector (particle_selector.h).
+bool is_rest_box(const nlohmann::json& set);
 
 // The particles (ascending) whose rest position lies in the block's box; at least one, or the block fails.
 std::vector<int> particles_in_region(Block& b, const ClothSpec& c);

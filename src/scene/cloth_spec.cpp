@@ -6,6 +6,7 @@
 
 #include "scene/cloth_mesh_spec.h"
 #include "scene/params.h"
+#include "scene/particle_selector.h"
 
 namespace kf {
 
@@ -124,7 +125,7 @@ ClothSpec parse_cloth_spec(Block& b, const std::filesystem::path& directory) {
   }
   s.mass = b.number("mass", s.mass, 1e-9, 1e6);
   const int p = s.particles();
-  if (b.has("pins") && b.json().at("pins").is_object()) {
+  if (b.has("pins") && is_rest_box(b.json().at("pins"))) {
     Block region = b.child("pins");
     s.pins = particles_in_region(region, s);
   } else if (s.mesh && b.has("pins") && b.json().at("pins").is_string()) {
@@ -132,6 +133,8 @@ ClothSpec parse_cloth_spec(Block& b, const std::filesystem::path& directory) {
     b.string("pins", "none", {"none"});  // the named edges are a grid's
   } else if (b.has("pins") && b.json().at("pins").is_string()) {
     s.pins = named_pin_set(b.string("pins", "none", kPinSets), s.nx, s.ny);
+  } else if (b.has("pins") && b.json().at("pins").is_object()) {
+    s.pins = parse_particle_selector(b, "pins", p, &s);  // a row, a column, a rectangle of (i, j), a region
   } else if (b.has("pins")) {
     s.pins = b.integers("pins", 0, 0, p - 1);
     std::sort(s.pins.begin(), s.pins.end());

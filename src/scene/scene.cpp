@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -10,6 +11,7 @@
 #include "core/json_depth.h"
 #include "scene/cloth_mesh_spec.h"
 #include "scene/params.h"
+#include "scene/particle_selector.h"
 #include "scene/svg_shape_spec.h"
 
 namespace kf {
@@ -33,25 +35,80 @@ TimeSpec parse_time(Block b) {
 }
 
 // Each keyframe type reads its own keys; the table below names the types the scene file may use.
-std::vector<Vec3> parse_targets(Block& b, const ObjectiveSpec& o, int particles) {
+// The particles a keyframe names (all when it names none), in order.
+std::vector<int> selected(const ObjectiveSpec& o, int particles) {
+  if (!o.particles.empty()) return o.particles;
+  std::vector<int> all(size_t(particles), 0);
+  for (int i = 0; i < particles; ++i) all[size_t(i)] = i;
+  return all;
+}
+
+// "offset" (one for the whole set, or one per particle) from each particle's place on the rest sheet
+// ("from": "rest", the cloth block's layout), instead of absolute "targets".
+std::vector<Vec3> offsets_from_rest(Block& b, const std::vector<int>& set, const Scene& s) {
+  if (b.has("targets")) b.fail("offset", "expected either \"targets\" or \"offset\", not both");
+  b.string("from", "rest", {"rest"});
+  if (!s.cloth)
+    b.fail("offset", "expected absolute \"targets\": an offset from the rest position needs a cloth (a flock's "
+                     "agents start at seeded random places)");
+  // [dx, dy, dz]: the whole set moved rigidly; [[dx, dy, dz], ...]: one per particle.
+  const Json& given = b.json().at("offset");
+  const bool rigid = given.is_array() && !given.empty() && given.front().is_number();
+  const std::vector<Vec3> offsets = rigid ? std::vector<Vec3>{b.vec3("offset")} : b.points3("offset", 1);
+  if (offsets.size() != 1 && offsets.size() != set.size())
+    b.fail("offset", "expected [dx, dy, dz] (the whole set moved rigidly) or one offset per particle (" +
+                         std::to_string(set.size()) + "), got " + std::to_string(offsets.size()));
+  std::vector<Vec3> targets;
+  for (size_t k = 0; k < set.size(); ++k)
+    targets.push_back(rest_position(*s.cloth, set[k]) + offsets[offsets.size() == 1 ? 0 : k]);
+  return targets;
+}
+
+// Flocks live on the ground (their controls have no vertical component): a position off it can never be met.
+void check_on_ground(Block& b, const Scene& s, const std::string& key, const std::vector<Vec3>& points) {
+  if (!s.flock) return;
+  for (size_t k = 0; k < points.size(); ++k)
+    if (std::abs(points[k].y()) > 1e-9)
+      b.fail_rel("/" + key + (key == "target" ? "" : "/" + std::to_string(k)),
+                 "expected a point on the ground, y = 0 (a flock moves on the ground and cannot reach y = " +
+                     Json(points[k].y()).dump() + ")");
+}
+
+std::vector<Vec3> parse_targets(Block& b, const ObjectiveSpec& o, const Scene& s, bool positions) {
+  const int particles = s.particles();
+  if (positions && b.has("offset")) return offsets_from_rest(b, selected(o, particles), s);
   std::vector<Vec3> targets = b.points3("targets", 1);
   const size_t n = o.particles.empty() ? size_t(particles) : o.particles.size();
   if (targets.size() != 1 && targets.size() != n)
     b.fail("targets", "expected 1 target or one per particle (" + std::to_string(n) + "), got " +
                           std::to_string(targets.size()));
+  if (positions) check_on_ground(b, s, "targets", targets);
   return targets;
 }
 
 ObjectiveKind parse_position(Block& b, const ObjectiveSpec& o, const Scene& s) {
-  return PositionKeyframe{parse_targets(b, o, s.particles())};
+  return PositionKeyframe{parse_targets(b, o, s, true)};
 }
 
 ObjectiveKind parse_velocity(Block& b, const ObjectiveSpec& o, const Scene& s) {
-  return VelocityKeyframe{parse_targets(b, o, s.particles())};
+  return VelocityKeyframe{parse_targets(b, o, s, false)};
 }
 
-ObjectiveKind parse_center_of_mass(Block& b, const ObjectiveSpec&, const Scene&) {
-  return CenterOfMassKeyframe{b.vec3("target")};
+// "target", or "offset" from the rest sheet's centre of mass of the particles ("from": "rest").
+ObjectiveKind parse_center_of_mass(Block& b, const ObjectiveSpec& o, const Scene& s) {
+  if (!b.has("offset")) {
+    const Vec3 target = b.vec3("target");
+    check_on_ground(b, s, "target", {target});
+    return CenterOfMassKeyframe{target};
+  }
+  if (b.has("target")) b.fail("offset", "expected either \"target\" or \"offset\", not both");
+  b.string("from", "rest", {"rest"});
+  if (!s.cloth)
+    b.fail("offset", "expected an absolute \"target\": an offset from the rest position needs a cloth");
+  const std::vector<int> set = selected(o, s.particles());
+  Vec3 mean = Vec3::Zero();
+  for (int i : set) mean += rest_position(*s.cloth, i) / double(set.size());
+  return CenterOfMassKeyframe{mean + b.vec3("offset")};
 }
 
 // The regular polygon through `n` points on a circle on the ground, counter-clockwise in (x, z) (clockwise
@@ -124,6 +181,12 @@ ObjectiveKind parse_shape(Block& b, const ObjectiveSpec&, const Scene& s) {
   k.coverage_weight = c.number("weight", 0.0, 0.0, 1e12);
   k.coverage_radius = c.number("radius", s.flock->avoidance.radius, 1e-3, 1e4);
   k.coverage_spacing = c.number("spacing", 0.5 * k.coverage_radius, 1e-3, 1e4);
+  if (const double n = region_sample_count(k.polygon, k.coverage_spacing); k.coverage_weight > 0 && !(n <= 1e5)) {
+    char msg[200];
+    std::snprintf(msg, sizeof msg, "the coverage grid over the shape's bounding box would have %.3g samples (at most "
+                  "100,000): raise \"spacing\"", n);
+    c.fail("spacing", msg);
+  }
   c.finish();
   return k;
 }
@@ -157,11 +220,11 @@ ObjectiveSpec parse_objective(Block b, const Scene& s) {
   o.frame = b.integer("frame", 0, s.time.frames);
   o.weight = b.number("weight", 1.0, 0.0, 1e12);
   const int p = s.particles();
-  if (b.has("particles") && s.cloth && b.json().at("particles").is_object()) {
+  if (b.has("particles") && s.cloth && is_rest_box(b.json().at("particles"))) {
     Block region = b.child("particles");
     o.particles = particles_in_region(region, *s.cloth);
   } else if (b.has("particles")) {
-    o.particles = b.integers("particles", 1, 0, p - 1);
+    o.particles = parse_particle_selector(b, "particles", p, s.cloth ? &*s.cloth : nullptr);
   }
   for (const ObjectiveType& t : kObjectiveTypes)
     if (type == t.name) o.kind = t.parse(b, o, s);
@@ -231,9 +294,14 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls, int fr
   o.max_memory = b.number("max_memory", o.max_memory, 0.0, 1e6);
   o.restarts = b.integer("restarts", o.restarts, 0, 1000);
   if (b.has("throw_search")) o.throw_search = b.integer("throw_search", 0, 0, 100000);
-  o.split_schedule = b.string("split_schedule", o.split_schedule, {"held", "adaptive"});
+  o.split_schedule = b.string("split_schedule", o.split_schedule == SplitSchedule::kHeld ? "held" : "adaptive",
+                               {"held", "adaptive"}) == "held"
+                         ? SplitSchedule::kHeld
+                         : SplitSchedule::kAdaptive;
   o.adjoint = b.string("adjoint", o.adjoint, {"exact", "swap"});
-  o.strategy = b.string("strategy", o.strategy, {"auto", "single"});
+  o.strategy = b.string("strategy", o.strategy == StagingStrategy::kAuto ? "auto" : "single", {"auto", "single"}) == "auto"
+                   ? StagingStrategy::kAuto
+                   : StagingStrategy::kSingle;
   o.window_frames = b.integer("window_frames", o.window_frames, 1, 1'000'000);
   o.window_growth = b.number("window_growth", o.window_growth, 1.0, 1e300);
   if (b.has("first_step")) o.first_step = b.number("first_step", 0.0, 0.0, 1e12);

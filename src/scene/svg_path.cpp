@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cctype>
 #include <cstring>
-#include <optional>
+#include <pugixml.hpp>
+#include <set>
 #include <utility>
 
 namespace kf {
@@ -210,9 +212,13 @@ class PathReader {
     if (sweep && dtheta < 0) dtheta += 2 * M_PI;
     const double r = std::max(rx, ry);
     const double step = tol_ < r ? 2 * std::acos(1 - tol_ / r) : M_PI;
-    const int n = std::max(1, int(std::ceil(std::abs(dtheta) / step)));
-    if (size_t(n) > max_points_) fail(cmd_at_, "the path flattens to more than " + std::to_string(max_points_) +
-                                                   " points: raise the tolerance or simplify the path");
+    // The step count in double precision first: a tolerance far below the radius makes it overflow an int
+    // (or the step round to 0).
+    const double steps = std::max(1.0, std::ceil(std::abs(dtheta) / step));
+    if (!(steps <= double(max_points_)))
+      fail(cmd_at_, "the path flattens to more than " + std::to_string(max_points_) +
+                        " points: raise the tolerance or simplify the path");
+    const int n = int(steps);
     for (int k = 1; k < n; ++k) {
       const double t = theta1 + dtheta * k / n;
       const Vec2 e(rx * std::cos(t), ry * std::sin(t));
@@ -298,73 +304,75 @@ int line_at(const std::string& text, size_t at) {
   throw std::runtime_error("line " + std::to_string(line_at(text, at)) + ": " + what);
 }
 
-// The attributes of the element `name` from `i` (after its name) up to its '>' or "/>": the value of "d",
-// if any, into `d`; a transform is refused. Returns where the attributes end.
-size_t read_attributes(const std::string& text, size_t i, const std::string& name, std::optional<std::string>& d) {
-  for (;;) {
-    while (i < text.size() && is_space(text[i])) ++i;
-    if (i >= text.size()) fail_at(text, i, "<" + name + "> is not closed");
-    if (text[i] == '>' || text.compare(i, 2, "/>") == 0) return i;
-    size_t k = i;
-    while (k < text.size() && !is_space(text[k]) && text[k] != '=' && text[k] != '>') ++k;
-    const std::string attr = text.substr(i, k - i);
-    while (k < text.size() && is_space(text[k])) ++k;
-    if (k >= text.size() || text[k] != '=') fail_at(text, i, "<" + name + ">: expected = after the attribute " + attr);
-    ++k;
-    while (k < text.size() && is_space(text[k])) ++k;
-    if (k >= text.size() || (text[k] != '"' && text[k] != '\''))
-      fail_at(text, i, "<" + name + ">: expected a quoted value for the attribute " + attr);
-    const size_t end = text.find(text[k], k + 1);
-    if (end == std::string::npos) fail_at(text, i, "<" + name + ">: the value of " + attr + " is not closed");
-    const std::string value = text.substr(k + 1, end - k - 1);
-    if (attr == "transform" || attr == "patternTransform" || attr == "gradientTransform")
-      fail_at(text, i, "<" + name + "> has a \"" + attr + "\" attribute, which is not applied: flatten the "
-              "transforms into the path data first (in Inkscape: Path > Object to Path, then ungroup)");
-    if (name == "path" && attr == "d") {
-      if (value.find('&') != std::string::npos) fail_at(text, i, "<path>'s d holds an entity reference (&...;)");
-      d = value;
-    }
-    i = end + 1;
-  }
+std::string local_name(const char* name) {
+  const char* colon = std::strrchr(name, ':');
+  return colon ? colon + 1 : name;
 }
 
-// Past a comment, CDATA section, declaration or processing instruction at `i` (they hold no elements);
-// `i` itself when none starts there.
-size_t skip_markup(const std::string& text, size_t i) {
-  static constexpr std::pair<const char*, const char*> kSkipped[] = {
-      {"<!--", "-->"}, {"<![CDATA[", "]]>"}, {"<?", "?>"}, {"<!", ">"}};
-  for (const auto& [open, close] : kSkipped)
-    if (text.compare(i, std::strlen(open), open) == 0) {
-      const size_t end = text.find(close, i + std::strlen(open));
-      if (end == std::string::npos) fail_at(text, i, std::string("\"") + open + "\" is not closed");
-      return end + std::strlen(close);
-    }
-  return i;
+// Whether a style attribute ("fill: red; transform: rotate(5deg)") sets the CSS transform property.
+bool style_has_transform(std::string_view style) {
+  for (size_t at = 0; at <= style.size();) {
+    const size_t end = std::min(style.find(';', at), style.size());
+    std::string_view decl = style.substr(at, end - at);
+    decl = decl.substr(0, decl.find(':'));
+    while (!decl.empty() && is_space(decl.front())) decl.remove_prefix(1);
+    while (!decl.empty() && is_space(decl.back())) decl.remove_suffix(1);
+    std::string name(decl);
+    for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (name == "transform") return true;
+    at = end + 1;
+  }
+  return false;
+}
+
+// Refuses what this reader would otherwise misread in one element's attributes: a repeated attribute (XML
+// forbids it; readers disagree on which one counts), a transform as an attribute or in its style, and an
+// entity reference in a path's d.
+void check_attributes(const std::string& text, const pugi::xml_node& node) {
+  const std::string name = local_name(node.name());
+  const size_t at = size_t(node.offset_debug());
+  std::set<std::string> seen;
+  for (const pugi::xml_attribute& a : node.attributes()) {
+    const std::string attr = a.name();
+    if (!seen.insert(attr).second) fail_at(text, at, "<" + name + "> has the attribute " + attr + " twice");
+    const std::string local = local_name(attr.c_str());
+    if (local == "transform" || local == "patternTransform" || local == "gradientTransform" ||
+        (local == "style" && style_has_transform(a.value())))
+      fail_at(text, at, "<" + name + "> has a " + (local == "style" ? "\"transform\" in its style" : "\"" + attr + "\" attribute") +
+              ", which is not applied: flatten the transforms into the path data first (in Inkscape: Path > Object "
+              "to Path, then ungroup)");
+    if (name == "path" && local == "d" && std::strchr(a.value(), '&'))
+      fail_at(text, at, "<path>'s d holds an entity reference (&...;)");
+  }
 }
 
 }  // namespace
 
 std::vector<SvgPathElement> svg_document_paths(const std::string& text) {
+  pugi::xml_document doc;
+  // Entities left unexpanded (a d holding one is refused) and the document type kept, to refuse it.
+  const unsigned options = (pugi::parse_default & ~pugi::parse_escapes) | pugi::parse_doctype;
+  const pugi::xml_parse_result parsed = doc.load_buffer(text.data(), text.size(), options, pugi::encoding_utf8);
+  if (!parsed) fail_at(text, size_t(std::max<ptrdiff_t>(parsed.offset, 0)), std::string("not well-formed XML: ") + parsed.description());
   std::vector<SvgPathElement> paths;
-  size_t i = 0;
-  while ((i = text.find('<', i)) != std::string::npos) {
-    const size_t tag = i;
-    if ((i = skip_markup(text, tag)) != tag) continue;
-    if (++i < text.size() && text[i] == '/') {  // an end tag
-      i = text.find('>', i);
-      if (i == std::string::npos) fail_at(text, tag, "an end tag is not closed");
-      continue;
+  std::vector<pugi::xml_node> stack = {doc};
+  while (!stack.empty()) {
+    const pugi::xml_node node = stack.back();
+    stack.pop_back();
+    if (node.type() == pugi::node_doctype)
+      fail_at(text, size_t(node.offset_debug()), "the document type declaration (<!DOCTYPE ...>) is refused: its "
+              "entities could add to or hide the shape");
+    if (node.type() == pugi::node_element) {
+      check_attributes(text, node);
+      if (local_name(node.name()) == "path") {
+        const pugi::xml_attribute d = node.attribute("d");
+        if (!d) fail_at(text, size_t(node.offset_debug()), "<path> without a \"d\" attribute");
+        paths.push_back({d.value(), line_at(text, size_t(node.offset_debug()))});
+      }
     }
-    size_t j = i;
-    while (j < text.size() && !is_space(text[j]) && text[j] != '>' && text[j] != '/') ++j;
-    std::string name = text.substr(i, j - i);
-    if (const size_t colon = name.rfind(':'); colon != std::string::npos) name = name.substr(colon + 1);
-    std::optional<std::string> d;
-    i = read_attributes(text, j, name, d);
-    if (name == "path") {
-      if (!d) fail_at(text, tag, "<path> without a \"d\" attribute");
-      paths.push_back({*d, line_at(text, tag)});
-    }
+    // Children in reverse so that the stack visits them in document order.
+    std::vector<pugi::xml_node> children(node.begin(), node.end());
+    stack.insert(stack.end(), children.rbegin(), children.rend());
   }
   if (paths.empty()) throw std::runtime_error("no <path d=\"...\"> element (shapes such as <rect> and text "
                                               "are not read: convert them to paths first)");

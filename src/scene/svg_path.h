@@ -38,9 +38,12 @@ struct SvgPathElement {
   int line = 0;
 };
 
-// The <path> elements of an SVG document, in document order. Throws std::runtime_error (with the line) for
-// what this reader does not apply: a "transform" attribute anywhere, a <path> without "d"; and when there
-// is no <path> at all. Other elements (rect, circle, text) are not read: convert them to paths first.
+// The <path> elements of an SVG document (read by pugixml), in document order. Throws std::runtime_error
+// (with the line) for XML that is not well formed; for what an XML reader and a person may read differently:
+// a document type declaration (its entities can hold elements), an attribute given twice, an entity in d;
+// for what this reader does not apply: a transform (attribute or CSS property in "style") anywhere, a <path>
+// without "d"; and when there is no <path> at all. Other elements (rect, circle, text) are not read:
+// convert them to paths first.
 std::vector<SvgPathElement> svg_document_paths(const std::string& text);
 
 }  // namespace kf

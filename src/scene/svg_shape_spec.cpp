@@ -1,9 +1,14 @@
 #include "scene/svg_shape_spec.h"
 
-#include <cmath>
-#include <fstream>
-#include <sstream>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+
+#include "core/file_name.h"
 #include "core/ground_region.h"
 #include "scene/svg_path.h"
 
@@ -13,6 +18,7 @@ namespace {
 
 // At most this many points in all: the shape terms visit every edge for every agent.
 constexpr size_t kMaxPoints = 20'000;
+constexpr off_t kMaxSvgBytes = 16 << 20;
 
 double signed_area(const std::vector<Vec2>& loop) {
   double a = 0;
@@ -22,6 +28,31 @@ double signed_area(const std::vector<Vec2>& loop) {
     a += p.x() * q.y() - q.x() * p.y();
   }
   return 0.5 * a;
+}
+
+// The SVG file's text: only a regular file (a FIFO would wait for a writer, /dev/zero never end) of at
+// most kMaxSvgBytes. Opened without blocking, then checked as opened.
+std::string read_svg_file(const Block& b, const std::filesystem::path& file) {
+  const std::string shown = printable(file.string());
+  const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) b.fail("file", "cannot open the SVG file " + shown);
+  struct stat st {};
+  std::string problem;
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) problem = ": not a regular file";
+  else if (st.st_size > kMaxSvgBytes) problem = ": larger than the 16 MiB an SVG file may be";
+  std::string text;
+  while (problem.empty()) {
+    char buf[1 << 16];
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) problem = std::string(": cannot read it: ") + std::strerror(errno);
+    if (n <= 0) break;
+    text.append(buf, size_t(n));
+    if (text.size() > size_t(kMaxSvgBytes)) problem = ": larger than the 16 MiB an SVG file may be";  // it grew
+  }
+  ::close(fd);
+  if (!problem.empty()) b.fail("file", shown + problem);
+  return text;
 }
 
 // Each subpath's loop in path units, and its name for messages ("subpath 2 at character 31").
@@ -58,19 +89,17 @@ NamedLoops read_loops(const Block& b, const std::string& key, const std::string&
     return out;
   }
   const std::filesystem::path file = scene_dir / source;
-  std::ifstream in(file, std::ios::binary);
-  if (!in) b.fail("file", "cannot open the SVG file " + file.string());
-  std::ostringstream text;
-  text << in.rdbuf();
+  const std::string shown = printable(file.string());
+  const std::string text = read_svg_file(b, file);
   std::vector<SvgPathElement> elements;
   try {
-    elements = svg_document_paths(text.str());
+    elements = svg_document_paths(text);
   } catch (const std::runtime_error& e) {
-    b.fail("file", file.string() + ": " + e.what());
+    b.fail("file", shown + ": " + printable(e.what()));
   }
   for (size_t k = 0; k < elements.size(); ++k) {
     const std::string where = "<path> " + std::to_string(k) + " at line " + std::to_string(elements[k].line);
-    read_path(elements[k].d, where + ", ", file.string() + ": " + where + ": d: ");
+    read_path(elements[k].d, where + ", ", shown + ": " + where + ": d: ");
   }
   return out;
 }

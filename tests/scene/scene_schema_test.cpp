@@ -49,7 +49,7 @@ bool has_type(const Json& v, const std::string& type) {
 void validate(const Json& v, const Json& schema, const std::string& at, std::vector<std::string>& problems) {
   static const std::set<std::string> kKnown = {"type",     "properties", "additionalProperties", "required",
                                                "items",    "minItems",   "maxItems",             "minimum",
-                                               "maximum",  "enum",       "anyOf",                "default",
+                                               "maximum",  "enum",       "anyOf",                "oneOf",    "default",
                                                "$schema",  "title",      "description"};
   for (auto it = schema.begin(); it != schema.end(); ++it)
     if (!kKnown.count(it.key())) throw std::logic_error("validator: keyword \"" + it.key() + "\" not supported");
@@ -61,6 +61,15 @@ void validate(const Json& v, const Json& schema, const std::string& at, std::vec
       if (p.empty()) return;
     }
     return fail("matches none of anyOf");
+  }
+  if (schema.contains("oneOf")) {
+    int matched = 0;
+    for (const Json& alt : schema["oneOf"]) {
+      std::vector<std::string> p;
+      validate(v, alt, at, p);
+      matched += p.empty();
+    }
+    if (matched != 1) fail("matches " + std::to_string(matched) + " of oneOf");
   }
   if (schema.contains("type") && !has_type(v, schema["type"])) return fail("expected " + schema["type"].get<std::string>());
   if (schema.contains("enum") && std::find(schema["enum"].begin(), schema["enum"].end(), v) == schema["enum"].end())
@@ -183,6 +192,19 @@ TEST_F(SceneSchema, RejectsWhatTheParserRejects) {
   missing["objectives"][0].erase("frame");
   EXPECT_EQ(problems_of(missing, committed_), std::vector<std::string>{"/objectives/0: missing required \"frame\""});
   EXPECT_THROW(parse_scene(missing.dump(), "bad.json"), InputError);
+}
+
+// The schema states the parser's rule of exactly one system.
+TEST_F(SceneSchema, StatesExactlyOneOfFlockAndCloth) {
+  const Json flock = Json::parse(read_text(kSource / "scenes/square.json"));
+  Json both = flock, neither = flock;
+  both["cloth"] = Json::object();
+  neither.erase("flock");
+  neither.erase("objectives");
+  EXPECT_EQ(problems_of(both, committed_), std::vector<std::string>{"/: matches 2 of oneOf"});
+  EXPECT_EQ(problems_of(neither, committed_), std::vector<std::string>{"/: matches 0 of oneOf"});
+  EXPECT_THROW(parse_scene(both.dump(), "bad.json"), InputError);
+  EXPECT_THROW(parse_scene(neither.dump(), "bad.json"), InputError);
 }
 
 // "$schema" is read and ignored; a misspelling of it is an unknown key like any other.

@@ -212,8 +212,32 @@ TEST(SvgPath, DocumentPathsInOrderWithTheirLines) {
   EXPECT_EQ(error("<svg>\n<rect width=\"1\" height=\"1\"/></svg>"),
             "no <path d=\"...\"> element (shapes such as <rect> and text are not read: convert them to paths first)");
   EXPECT_EQ(error("<svg>\n\n<path fill=\"red\"/></svg>"), "line 3: <path> without a \"d\" attribute");
-  EXPECT_EQ(error("<svg>\n<path d=\"M 0 0 H 1 V 1 Z/></svg>"), "line 2: <path>: the value of d is not closed");
-  EXPECT_EQ(error("<svg><!-- open"), "line 1: \"<!--\" is not closed");
+  EXPECT_EQ(error("<svg>\n<path d=\"M 0 0 H 1 V 1 Z/></svg>"), "line 2: not well-formed XML: Error parsing element attribute");
+  EXPECT_EQ(error("<svg><!-- open"), "line 1: not well-formed XML: Error parsing comment");
+}
+
+// What an XML parser reads differently from what a person sees is refused: a document type (its entities can
+// hold elements), a repeated attribute, a transform in a style, an entity in d.
+TEST(SvgPath, DocumentTypesRepeatedAttributesAndStyleTransformsAreRefused) {
+  auto error = [](const std::string& text) {
+    try {
+      svg_document_paths(text);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(error("<!DOCTYPE svg [<!ENTITY p \"<path d='M 0 0 H 9 V 9 Z'/>\">]>\n<svg>&p;</svg>"),
+            "line 1: the document type declaration (<!DOCTYPE ...>) is refused: its entities could add to or hide the "
+            "shape");
+  EXPECT_EQ(error("<svg>\n<path d=\"M 0 0 H 1 V 1 Z\" fill=\"red\" d=\"M 0 0 H 9 V 9 Z\"/></svg>"),
+            "line 2: <path> has the attribute d twice");
+  EXPECT_EQ(error("<svg>\n\n<path style=\"fill:red;transform:scale(2)\" d=\"M 0 0 H 1 V 1 Z\"/></svg>"),
+            "line 3: <path> has a \"transform\" in its style, which is not applied: flatten the transforms into the "
+            "path data first (in Inkscape: Path > Object to Path, then ungroup)");
+  EXPECT_EQ(error("<svg><path d=\"M 0 0 H 1 V 1 &amp; Z\"/></svg>"), "line 1: <path>'s d holds an entity reference (&...;)");
+  // A style without a transform, and a property whose name merely ends in "transform", are read.
+  EXPECT_EQ(error("<svg><path style=\"fill:red; text-transform: none\" d=\"M 0 0 H 1 V 1 Z\"/></svg>"), "accepted");
 }
 
 }  // namespace

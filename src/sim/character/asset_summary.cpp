@@ -11,6 +11,8 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/file_name.h"
+#include "sim/mesh_import.h"
 #include "sim/character/character.h"
 
 namespace kf {
@@ -122,12 +124,12 @@ void read_animations(const aiScene& scene, AssetSummary& s, const std::map<std::
 AssetSummary summarize_asset(const std::filesystem::path& file) {
   const std::string name = file.string();
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw InputError(name + ": file not found");
-  Assimp::Importer importer;
-  importer.SetPropertyInteger(AI_CONFIG_PP_LBW_MAX_WEIGHTS, Character::kMaxInfluences);
-  const aiScene* scene = importer.ReadFile(
-      name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_LimitBoneWeights);
-  if (!scene || !scene->mRootNode) throw InputError(name + ": cannot read it: " + importer.GetErrorString());
+  if (!std::filesystem::exists(file, ec)) throw InputError(printable(name) + ": file not found");
+  // An untrusted file: read in a child process (mesh_import.h), finite, indices checked.
+  const std::unique_ptr<aiScene> owned = import_mesh_file(
+      file, {aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_LimitBoneWeights,
+             Character::kMaxInfluences});
+  const aiScene* scene = owned.get();
   AssetSummary s;
   s.file = name;
   read_metadata(*scene, s);

@@ -9,6 +9,8 @@
 #include <unordered_map>
 
 #include "core/error.h"
+#include "core/file_name.h"
+#include "sim/mesh_import.h"
 
 namespace kf {
 namespace {
@@ -165,7 +167,7 @@ void Character::read_meshes(const aiScene& scene, const std::unordered_map<std::
     for (unsigned b = 0; b < mesh->mNumBones; ++b) {
       const aiBone* bone = mesh->mBones[b];
       const auto it = by_name.find(bone->mName.C_Str());
-      if (it == by_name.end()) throw InputError(name + ": bone '" + bone->mName.C_Str() + "' has no node");
+      if (it == by_name.end()) throw InputError(name + ": bone '" + printable(bone->mName.C_Str()) + "' has no node");
       const int bone_index = static_cast<int>(bones_.size());
       bones_.push_back({bone->mName.C_Str(), it->second, to_affine(bone->mOffsetMatrix)});
       for (unsigned w = 0; w < bone->mNumWeights; ++w) {
@@ -197,17 +199,15 @@ void Character::read_meshes(const aiScene& scene, const std::unordered_map<std::
 
 Character::Character(const std::filesystem::path& file, const CharacterOptions& options)
     : options_(options), file_(file.string()) {
-  const std::string name = file.string();
+  const std::string name = printable(file.string());
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec))
+  if (!std::filesystem::exists(file, ec))
     throw InputError(name + ": character mesh not found (expected a file assimp can read, e.g. .X)");
 
-  Assimp::Importer importer;
-  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_LimitBoneWeights |
-                         aiProcess_PopulateArmatureData;
-  importer.SetPropertyInteger(AI_CONFIG_PP_LBW_MAX_WEIGHTS, kMaxInfluences);
-  const aiScene* scene = importer.ReadFile(name, flags);
-  if (!scene) throw InputError(name + ": cannot read character mesh: " + importer.GetErrorString());
+  // An untrusted file: read in a child process (mesh_import.h), finite, indices checked.
+  const std::unique_ptr<aiScene> owned = import_mesh_file(
+      file, {aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_LimitBoneWeights, kMaxInfluences});
+  const aiScene* scene = owned.get();
   if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !scene->mRootNode || scene->mNumMeshes == 0)
     throw InputError(name + ": character file has no complete mesh");
   if (scene->mNumAnimations == 0) throw InputError(name + ": character file has no animation");

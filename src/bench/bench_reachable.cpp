@@ -1,0 +1,121 @@
+// The reachable-by-construction suite: each generated scene optimised with `keyframe optimize`'s own job at
+// its default settings and judged by its keyframes (opt/diagnosis.h), a table a scene and one a class.
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <iostream>
+#include <map>
+
+#include "bench/bench_point.h"
+#include "bench/bench_reachable.h"
+#include "app/optimize_job.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "report/plot.h"
+
+namespace kf {
+
+namespace {
+
+std::string load_average() {
+  std::ifstream in("/proc/loadavg");
+  std::string a, b, c;
+  in >> a >> b >> c;
+  return a + " " + b + " " + c;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// "smoke": the first scene of every class and the first multi-keyframe drop and throw.
+bool wanted(const ReachableSweepOptions& o, const std::string& name) {
+  if (o.scenes.empty()) return true;
+  for (const std::string& s : o.scenes) {
+    if (s == name) return true;
+    if (s == "smoke" && (name.size() > 2 && name.compare(name.size() - 2, 2, "-0") == 0)) return true;
+    if (s == "smoke" && (name == "drop-collider-1" || name == "throw-1")) return true;
+  }
+  return false;
+}
+
+struct ClassTally {
+  int scenes = 0, passed = 0;
+  std::vector<double> evaluations, seconds;
+};
+
+}  // namespace
+
+nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesystem::path& out) {
+  CsvTable t({"scene", "class", "keyframes", "friction", "thrown", "character", "controls", "particles", "keyframe",
+              "miss_before", "miss_after", "evaluations", "seconds", "outcome", "pass"});
+  nlohmann::json summary = {{"seed", o.seed}, {"load_before", load_average()}};
+  std::map<std::string, ClassTally> tally;
+  ensure_directory(o.scene_dir);
+  ensure_directory(out / "reports");
+  int passed = 0, rows = 0;
+  for (const auto& [name, kind] : reachable_suite(o)) {
+    if (!wanted(o, name)) continue;
+    const int index = std::stoi(name.substr(name.rfind('-') + 1));
+    const std::filesystem::path file = o.scene_dir / (name + ".json");
+    const ReachableScene r = generate_reachable(kind, o.seed, index, false, o.scene_dir);
+    write_file_atomic(file, r.scene.dump(1) + "\n");
+    if (o.generate_only) continue;
+    OptimizeOptions opt;
+    opt.out = (o.runs_dir / name).string();
+    opt.quiet = true;
+    opt.max_seconds = o.max_seconds;
+    std::cerr << "bench reachable: " << name << " (load " << load_average() << ")" << std::endl;
+    const auto start = std::chrono::steady_clock::now();
+    const OptimizeOutcome outcome = optimize_job(file, opt);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::ifstream in(outcome.dir / "report.json");
+    const nlohmann::json report = nlohmann::json::parse(in);
+    write_file_atomic(out / "reports" / (name + ".json"), report.dump(1) + "\n");
+    const nlohmann::json* worst = nullptr;
+    for (const auto& k : report.at("keyframe_errors"))
+      if (k.at("judged").get<bool>() &&
+          (!worst || k.at("miss_after").get<double>() > worst->at("miss_after").get<double>()))
+        worst = &k;
+    if (!worst) continue;
+    const bool pass = report.at("diagnosis").at("reached").get<bool>() && seconds <= o.pass_seconds;
+    const int evaluations = report.at("evaluations").get<int>();
+    passed += pass;
+    ++rows;
+    ClassTally& c = tally[kind];
+    ++c.scenes;
+    c.passed += pass;
+    c.evaluations.push_back(evaluations);
+    c.seconds.push_back(seconds);
+    t.add({name, kind, std::to_string(r.keyframes), r.friction ? "yes" : "no", r.thrown ? "yes" : "no",
+           r.character ? "yes" : "no", r.scene.at("controls").at("kind").get<std::string>(),
+           std::to_string(report.contains("particles") ? report.at("particles").get<int>() : 0),
+           worst->at("name").get<std::string>(), fmt(worst->at("miss_before").get<double>()),
+           fmt(worst->at("miss_after").get<double>()), std::to_string(evaluations), fmt(seconds),
+           report.at("diagnosis").at("outcome").get<std::string>(), pass ? "yes" : "no"});
+    t.write(out / "reachable.csv");  // after every scene: a cut-off run keeps what it measured
+    summary["diagnoses"][name] = outcome.diagnosis;
+  }
+  if (o.generate_only) return summary;
+  CsvTable classes({"class", "scenes", "passed", "pass_rate", "median_evaluations", "median_seconds", "worst_seconds"});
+  for (const auto& [kind, c] : tally)
+    classes.add({kind, std::to_string(c.scenes), std::to_string(c.passed), fmt(double(c.passed) / c.scenes),
+                 fmt(median(c.evaluations)), fmt(median(c.seconds)),
+                 fmt(*std::max_element(c.seconds.begin(), c.seconds.end()))});
+  classes.write(out / "reachable_classes.csv");
+  if (rows > 0)
+    bar_plot_csv(out / "reachable_classes.csv", out / "reachable.png", "pass rate by class (1: every scene passed)",
+                 {classes.col("class")}, {classes.col("pass_rate")}, false);
+  summary["load_after"] = load_average();
+  summary["passed"] = passed;
+  summary["scenes"] = rows;
+  write_file_atomic(out / "load.txt", "load average (1, 5, 15 min) before: " + summary["load_before"].get<std::string>() +
+                                          "\nafter: " + summary["load_after"].get<std::string>() + "\n");
+  std::cout << "reachable.csv: " << passed << " of " << rows << " scenes pass\n" << classes.excerpt(100) << std::endl;
+  return summary;
+}
+
+}  // namespace kf

@@ -1,0 +1,75 @@
+#pragma once
+// Scenes whose keyframes are reachable by construction (`keyframe bench --only reachable`).
+//
+// Each scene is a base scene (a sheet hanging, dropped or thrown, a cape on a character, a flock) and a
+// variant that differs from it only by what the scene's controls express exactly: gravity tilted by dg
+// (per-particle forces m dg reproduce it), initial velocities changed by dv + w x r (initial-velocity
+// controls), or a flock pushed by one constant force per agent. The variant is simulated and its particles
+// at one to three frames become the base scene's keyframe targets, so a solution exists and a miss is the
+// optimiser's.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/types.h"
+#include "scene/scene.h"
+
+namespace kf {
+
+// What separates the variant from its base scene.
+struct ReachableVariant {
+  Vec3 dg = Vec3::Zero();     // cloth: gravity change, m/s^2 (forces m dg on every particle)
+  Vec3 dv = Vec3::Zero();     // cloth: initial velocity change of every free particle, m/s
+  Vec3 omega = Vec3::Zero();  // cloth: plus omega x (x - centre of the free particles), rad/s
+  Vec3 force = Vec3::Zero();  // flock: a constant horizontal force on every agent, N
+};
+
+struct ReachableScene {
+  std::string name;   // "<class>-<index>"
+  std::string kind;   // its class
+  nlohmann::json scene;  // the scene file, keyframes included
+  ReachableVariant variant;
+  int keyframes = 0;
+  bool friction = false, thrown = false, character = false;
+};
+
+// The classes, in the order the suite draws them.
+const std::vector<std::string>& reachable_classes();
+
+// Scene `index` of class `kind` for `seed` (the same arguments give the same scene). `reduced`: a small
+// version (an 8 x 8 sheet or 16 agents, at most 20 frames) for tests. `directory` is where the scene file
+// will live (relative asset paths are written from it). Throws std::invalid_argument for an unknown class.
+ReachableScene generate_reachable(const std::string& kind, unsigned seed, int index, bool reduced,
+                                  const std::filesystem::path& directory);
+
+// The variant's positions (3p) at every frame 0..frames of `base` (whose keyframes are ignored).
+std::vector<VecX> simulate_variant(const Scene& base, const ReachableVariant& variant);
+
+// The control force of every step that makes `base` follow its variant (m dg per particle, or the flock's
+// force), and the initial velocities (3p) it starts with: what the tests replay.
+VecX variant_step_force(const Scene& base, const ReachableVariant& variant);
+VecX variant_initial_velocity(const Scene& base, const ReachableVariant& variant);
+
+struct ReachableSweepOptions {
+  unsigned seed = 52;
+  int count = 100;                   // scenes, drawn over the classes by their shares
+  std::vector<std::string> classes;  // only these (empty: all)
+  std::vector<std::string> scenes;   // only these names (empty: all; "smoke": one a class and two more)
+  std::filesystem::path scene_dir = "tests/results/reachable/scenes";  // where the scene files are written
+  std::filesystem::path runs_dir = "out/reachable";  // each scene's run directory
+  bool generate_only = false;        // write the scene files and stop
+  double max_seconds = 120;          // each scene's optimiser stops after this (per stage)
+  double pass_seconds = 120;         // a scene passes only within this wall time (the whole job)
+};
+
+// The suite's scene list for the options (name, class), in order.
+std::vector<std::pair<std::string, std::string>> reachable_suite(const ReachableSweepOptions& o);
+
+// Generates the suite, writes each scene file, optimises each with `keyframe optimize`'s job at its
+// defaults and writes reachable.csv (a row a scene, written after each), reachable_classes.csv (pass
+// rate, median evaluations, median and worst seconds a class), reachable.png and load.txt.
+nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesystem::path& out);
+
+}  // namespace kf

@@ -1,0 +1,151 @@
+// The reachable-by-construction scenes (bench/bench_reachable.h): the controls that copy the variant meet
+// every keyframe through the optimiser's own problem, and the uncontrolled scene misses them.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include "bench/bench_reachable.h"
+#include "adjoint/rollout.h"
+#include "opt/problem.h"
+#include "scene/scene.h"
+#include "sim/make_system.h"
+
+namespace kf {
+namespace {
+
+const std::filesystem::path kDir = std::filesystem::path(KEYFRAME_SOURCE_DIR) / "tests/results/reachable/scenes";
+
+Scene parsed(const ReachableScene& r) { return parse_scene(r.scene.dump(), kDir / (r.name + ".json")); }
+
+// The optimisation variables that copy the variant: its initial velocities, or its force in every block.
+VecX variant_controls(const Scene& scene, Problem& problem, const ReachableVariant& variant) {
+  const Controls& c = problem.controls();
+  if (!c.forces()) return c.from_initial_velocity(variant_initial_velocity(scene, variant));
+  const VecX u = variant_step_force(scene, variant);
+  const bool planar = problem.system().planar();
+  const int p = problem.system().particles(), nc = planar ? 2 : 3;
+  const int comps[3] = {0, planar ? 2 : 1, 2};
+  VecX z = VecX::Zero(problem.size());
+  EXPECT_EQ(z.size() % (p * nc), 0);
+  for (int b = 0; b < z.size() / (p * nc); ++b)
+    for (int i = 0; i < p; ++i)
+      for (int k = 0; k < nc; ++k) z(b * p * nc + i * nc + k) = u(3 * i + comps[k]);
+  return z;
+}
+
+double keyframe_terms(const Problem& problem) {
+  double s = 0;
+  for (const auto& [name, value] : problem.breakdown())
+    if (name != "effort") s += value;
+  return s;
+}
+
+// The classes without and with a character (Embree's queries run untrapped: tests/test_main.cpp).
+std::vector<std::string> classes(bool character) {
+  std::vector<std::string> v;
+  for (const std::string& c : reachable_classes())
+    if ((c.rfind("cape", 0) == 0) == character) v.push_back(c);
+  return v;
+}
+
+std::string test_name(const testing::TestParamInfo<std::string>& info) {
+  std::string s = info.param;
+  for (char& c : s)
+    if (c == '-') c = '_';
+  return s;
+}
+
+void expect_variant_controls_meet_the_keyframes(const std::string& kind) {
+  for (int index = 0; index < 4; ++index) {
+    SCOPED_TRACE(kind + "-" + std::to_string(index));
+    const ReachableScene r = generate_reachable(kind, 52, index, true, kDir);
+    const Scene scene = parsed(r);
+    ASSERT_EQ(int(scene.objectives.size()), r.keyframes);
+    auto sys = make_system(scene);
+    Problem problem(scene, scene.time, *sys);
+    problem.evaluate(problem.initial_guess(), nullptr);
+    const double before = keyframe_terms(problem);
+    problem.evaluate(variant_controls(scene, problem, r.variant), nullptr);
+    const double after = keyframe_terms(problem);
+    EXPECT_GT(before, 0);
+    EXPECT_LT(after, 1e-10 * before) << "uncontrolled " << before;
+  }
+}
+
+class ReachableClass : public testing::TestWithParam<std::string> {};
+class ReachableCapeClass : public testing::TestWithParam<std::string> {};
+
+TEST_P(ReachableClass, VariantControlsMeetEveryKeyframeTheUncontrolledSceneMisses) {
+  expect_variant_controls_meet_the_keyframes(GetParam());
+}
+TEST_P(ReachableCapeClass, VariantControlsMeetEveryKeyframeTheUncontrolledSceneMisses) {
+  expect_variant_controls_meet_the_keyframes(GetParam());
+}
+
+INSTANTIATE_TEST_SUITE_P(Generated, ReachableClass, testing::ValuesIn(classes(false)), test_name);
+INSTANTIATE_TEST_SUITE_P(Generated, ReachableCapeClass, testing::ValuesIn(classes(true)), test_name);
+
+// Forces m dg on every particle move a sheet as its gravity tilted by dg does (what the variant stands for).
+void expect_forces_match_tilted_gravity(const std::vector<std::string>& kinds) {
+  for (const std::string& kind : kinds) {
+    SCOPED_TRACE(kind);
+    const ReachableScene r = generate_reachable(kind, 52, 1, true, kDir);
+    ASSERT_GT(r.variant.dg.norm(), 0.5);
+    const Scene scene = parsed(r);
+    const std::vector<VecX> forced = simulate_variant(scene, r.variant);
+    Scene tilted = scene;
+    tilted.cloth->gravity += r.variant.dg;
+    const std::vector<VecX> fallen = simulate_variant(tilted, ReachableVariant{});
+    ASSERT_EQ(forced.size(), fallen.size());
+    const double moved = (forced.back() - forced.front()).cwiseAbs().maxCoeff();
+    EXPECT_GT(moved, 0.01);
+    EXPECT_LT((forced.back() - fallen.back()).cwiseAbs().maxCoeff(), 1e-6);
+  }
+}
+
+TEST(ReachableScenes, ForcesOfTheTiltMatchATiltedGravity) {
+  expect_forces_match_tilted_gravity({"hang-corners", "drop-collider", "hang-points"});
+}
+TEST(ReachableCapeScenes, ForcesOfTheTiltMatchATiltedGravity) { expect_forces_match_tilted_gravity({"cape", "cape-wuson"}); }
+
+// The committed suite holds the shares the issue asks for: >= 100 scenes, >= 8 classes, >= 30 % with
+// keyframes at two or three frames, >= 20 % friction, >= 20 % initial-velocity throws, >= 10 % on a
+// character; and the generator still writes those files.
+TEST(ReachableScenes, CommittedSuiteCoversItsShares) {
+  const auto suite = reachable_suite(ReachableSweepOptions{});
+  ASSERT_GE(suite.size(), 100u);
+  std::set<std::string> classes;
+  int multi = 0, friction = 0, thrown = 0, character = 0;
+  for (const auto& [name, kind] : suite) {
+    std::ifstream in(kDir / (name + ".json"));
+    ASSERT_TRUE(in) << name;
+    const nlohmann::json s = nlohmann::json::parse(in);
+    classes.insert(kind);
+    std::set<int> frames;
+    for (const auto& k : s.at("objectives")) frames.insert(k.at("frame").get<int>());
+    multi += frames.size() >= 2;
+    bool rubs = false;
+    if (s.contains("cloth") && s["cloth"].contains("colliders"))
+      for (const auto& c : s["cloth"]["colliders"]) rubs |= c.value("friction", 0.0) > 0;
+    friction += rubs;
+    thrown += s.at("controls").at("kind") == "initial_velocity";
+    character += s.contains("character");
+  }
+  const double n = double(suite.size());
+  EXPECT_GE(classes.size(), 8u);
+  EXPECT_GE(multi / n, 0.3);
+  EXPECT_GE(friction / n, 0.2);
+  EXPECT_GE(thrown / n, 0.2);
+  EXPECT_GE(character / n, 0.1);
+  for (const auto& [name, kind] : {suite[0], suite[13]}) {
+    std::ifstream in(kDir / (name + ".json"));
+    const ReachableScene r = generate_reachable(kind, ReachableSweepOptions{}.seed,
+                                                std::stoi(name.substr(name.rfind('-') + 1)), false, kDir);
+    EXPECT_EQ(r.scene, nlohmann::json::parse(in)) << name;
+  }
+}
+
+}  // namespace
+}  // namespace kf
