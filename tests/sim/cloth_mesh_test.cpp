@@ -7,6 +7,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "app/run_dir.h"
 #include "core/error.h"
 #include "opt/problem.h"
 #include "scene/cloth_mesh_spec.h"
@@ -245,6 +246,13 @@ TEST(ClothMeshSpec, PinsAndKeyframeParticlesByRegionOfTheRestShape) {
   EXPECT_LT(s.cloth->pins.size(), 35u);
   ASSERT_FALSE(s.objectives[0].particles.empty());
   for (int i : s.objectives[0].particles) EXPECT_GE(s.cloth->mesh->vertices[size_t(i)].x(), 0.5);
+}
+
+// A run directory's copy of the scene names the mesh file absolutely, so render and export read it there.
+TEST(ClothMeshSpec, ARunsSceneCopyNamesTheMeshFileAbsolutely) {
+  nlohmann::json j = nlohmann::json::parse(R"({"cloth": {"mesh": {"file": "../assets/cloth/flag.obj"}}})");
+  absolutise_scene_paths(j, "/data/shots/scenes");
+  EXPECT_EQ(j["cloth"]["mesh"]["file"], "/data/shots/assets/cloth/flag.obj");
 }
 
 std::string load_error(const std::string& text, const std::filesystem::path& file) {
