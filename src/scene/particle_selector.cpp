@@ -88,7 +88,11 @@ const std::vector<std::string>& named_particle_sets() {
 std::vector<int> parse_particle_selector(Block& b, const std::string& key, int particles, const ClothSpec* sheet) {
   const Json& j = b.json().at(key);
   std::vector<int> out;
-  if (j.is_string()) {
+  if (sheet && sheet->mesh && !j.is_array()) {  // rows, columns and named edges are a grid's
+    if (j.is_object()) b.fail(key, "expected vertex indices, \"all\" or a rest-space box {\"min\", \"max\"} (a mesh cloth)");
+    b.string(key, std::vector<std::string>{"all"});
+    for (int i = 0; i < particles; ++i) out.push_back(i);
+  } else if (j.is_string()) {
     const std::string name =
         b.string(key, sheet ? named_particle_sets() : std::vector<std::string>{"all"});
     if (sheet) out = named_set(name, sheet->nx, sheet->ny);
@@ -105,6 +109,7 @@ std::vector<int> parse_particle_selector(Block& b, const std::string& key, int p
 }
 
 Vec3 rest_position(const ClothSpec& c, int index) {
+  if (c.mesh) return c.mesh->vertices[size_t(index)];
   const int i = index % c.nx, j = index / c.nx;
   return c.origin + i * (c.width / (c.nx - 1)) * c.u_axis + j * (c.height / (c.ny - 1)) * c.v_axis;
 }
