@@ -112,24 +112,31 @@ ExportMesh from_render_mesh(const std::string& name, const Mesh& m, const Vec3& 
   return e;
 }
 
-// The cloth grid at one frame as a triangle mesh with area-weighted vertex normals.
+// The cloth at one frame as a triangle mesh with area-weighted vertex normals: the grid's quads split along
+// one diagonal, or the mesh's faces (mesh.triangles()).
 ExportMesh cloth_mesh(const RunData& run, const ClothSpec& cloth, int frame) {
-  const int nx = cloth.nx, ny = cloth.ny;
   const VecX& x = run.trajectory.x[size_t(frame)];
+  const int p = cloth.particles();
   ExportMesh e{"cloth", {}, {}, {}, run.scene.render.cloth_front, "vertex i is particle i"};
-  std::vector<Vec3> normal(size_t(nx) * ny, Vec3::Zero());
-  for (int j = 0; j + 1 < ny; ++j)
-    for (int i = 0; i + 1 < nx; ++i) {
-      const uint32_t a = uint32_t(j * nx + i), b = a + 1, c = a + uint32_t(nx) + 1, d = a + uint32_t(nx);
-      e.indices.insert(e.indices.end(), {a, b, c, a, c, d});
-      const Vec3 n1 = (seg(x, int(b)) - seg(x, int(a))).cross(seg(x, int(c)) - seg(x, int(a)));
-      const Vec3 n2 = (seg(x, int(c)) - seg(x, int(a))).cross(seg(x, int(d)) - seg(x, int(a)));
-      for (uint32_t v : {a, b, c}) normal[v] += n1;
-      for (uint32_t v : {a, c, d}) normal[v] += n2;
-    }
-  for (int i = 0; i < nx * ny; ++i) {
-    const Vec3 p = seg(x, i), n = normal[size_t(i)].norm() > 1e-30 ? normal[size_t(i)].normalized() : Vec3::UnitY();
-    e.p.insert(e.p.end(), {float(p.x()), float(p.y()), float(p.z())});
+  if (cloth.mesh) {
+    for (int v : cloth.mesh->triangles()) e.indices.push_back(uint32_t(v));
+  } else {
+    const int nx = cloth.nx, ny = cloth.ny;
+    for (int j = 0; j + 1 < ny; ++j)
+      for (int i = 0; i + 1 < nx; ++i) {
+        const uint32_t a = uint32_t(j * nx + i), b = a + 1, c = a + uint32_t(nx) + 1, d = a + uint32_t(nx);
+        e.indices.insert(e.indices.end(), {a, b, c, a, c, d});
+      }
+  }
+  std::vector<Vec3> normal(size_t(p), Vec3::Zero());
+  for (size_t t = 0; t + 2 < e.indices.size(); t += 3) {
+    const int a = int(e.indices[t]), b = int(e.indices[t + 1]), c = int(e.indices[t + 2]);
+    const Vec3 n = (seg(x, b) - seg(x, a)).cross(seg(x, c) - seg(x, a));
+    for (int v : {a, b, c}) normal[size_t(v)] += n;
+  }
+  for (int i = 0; i < p; ++i) {
+    const Vec3 q = seg(x, i), n = normal[size_t(i)].norm() > 1e-30 ? normal[size_t(i)].normalized() : Vec3::UnitY();
+    e.p.insert(e.p.end(), {float(q.x()), float(q.y()), float(q.z())});
     e.n.insert(e.n.end(), {float(n.x()), float(n.y()), float(n.z())});
   }
   return e;

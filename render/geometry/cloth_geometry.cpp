@@ -46,13 +46,43 @@ void add_collider_bounds(const ColliderShape& shape, Bounds& b) {
              shape);
 }
 
-void build_cloth(const Scene& scene, const Trajectory& traj, int f, double scale, FrameGeometry& g) {
-  const RenderSpec& rs = scene.render;
-  const int nx = scene.cloth->nx, ny = scene.cloth->ny;
-  CHECK_EQ(traj.particles, nx * ny);  // run directories are validated against their scene when read
-  const VecX& x = traj.x[f];
+namespace {
+// A mesh cloth's triangles with area-weighted vertex normals, in a checker of rest-space squares (the two
+// widest axes of its rest box).
+void add_mesh_cloth(const ClothMesh& mesh, const VecX& x, const RenderSpec& rs, Mesh& m) {
+  const std::vector<int> tri = mesh.triangles();
+  std::vector<Vec3> normal(mesh.vertices.size(), Vec3::Zero());
+  for (size_t t = 0; t < tri.size(); t += 3) {
+    const Vec3 a = seg(x, tri[t]), n = (Vec3(seg(x, tri[t + 1])) - a).cross(Vec3(seg(x, tri[t + 2])) - a);
+    for (int k = 0; k < 3; ++k) normal[size_t(tri[t + k])] += n;
+  }
+  for (Vec3& n : normal) n = n.norm() > 1e-15 ? Vec3(n.normalized()) : Vec3::UnitY();
+  Bounds rest;
+  for (const Vec3& p : mesh.vertices) rest.add(p);
+  const Vec3 lo = rest.empty() ? Vec3::Zero() : rest.lo, size = rest.empty() ? Vec3::Ones() : Vec3(rest.hi - rest.lo);
+  int axes[3] = {0, 1, 2};
+  std::sort(axes, axes + 3, [&](int a, int b) { return size[a] > size[b]; });
+  const double side = std::max(size[axes[0]], 1e-9);
+  for (size_t t = 0; t < tri.size(); t += 3) {
+    bool odd = false;
+    if (rs.checker > 0) {
+      const Vec3 c = (mesh.vertices[size_t(tri[t])] + mesh.vertices[size_t(tri[t + 1])] + mesh.vertices[size_t(tri[t + 2])]) / 3;
+      const int si = int(std::floor((c[axes[0]] - lo[axes[0]]) / side * rs.checker));
+      const int sj = int(std::floor((c[axes[1]] - lo[axes[1]]) / side * rs.checker));
+      odd = ((si + sj) & 1) != 0;
+    }
+    const Vec3 front = odd ? rs.cloth_front * 0.72 : rs.cloth_front;
+    const Vec3 back = odd ? rs.cloth_back * 0.8 : rs.cloth_back;
+    const uint32_t base = uint32_t(m.vertices.size());
+    for (int k = 0; k < 3; ++k) add_vertex(m, seg(x, tri[t + k]), normal[size_t(tri[t + k])], front, back);
+    m.indices.insert(m.indices.end(), {base, base + 1, base + 2});
+  }
+}
+
+// The grid's quads with smooth normals from central differences, in a checker of `squares` per side.
+void add_grid_cloth(const ClothSpec& cloth, const VecX& x, const RenderSpec& rs, Mesh& m) {
+  const int nx = cloth.nx, ny = cloth.ny;
   auto P = [&](int i, int j) -> Vec3 { return seg(x, j * nx + i); };
-  // Smooth normals from central differences of the grid.
   std::vector<Vec3> normal(size_t(nx) * ny);
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) {
@@ -62,7 +92,6 @@ void build_cloth(const Scene& scene, const Trajectory& traj, int f, double scale
       normal[size_t(j) * nx + i] = c.norm() > 1e-15 ? c.normalized() : Vec3::UnitY();
     }
   const int squares = rs.checker;
-  Mesh& m = g.objects;
   for (int j = 0; j + 1 < ny; ++j)
     for (int i = 0; i + 1 < nx; ++i) {
       bool odd = false;
@@ -78,6 +107,16 @@ void build_cloth(const Scene& scene, const Trajectory& traj, int f, double scale
         add_vertex(m, P(ci[k], cj[k]), normal[size_t(cj[k]) * nx + ci[k]], front, back);
       m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
     }
+}
+}  // namespace
+
+void build_cloth(const Scene& scene, const Trajectory& traj, int f, double scale, FrameGeometry& g) {
+  const RenderSpec& rs = scene.render;
+  // Run directories are validated against their scene when read.
+  CHECK_EQ(traj.particles, scene.cloth->particles());
+  Mesh& m = g.objects;
+  if (scene.cloth->mesh) add_mesh_cloth(*scene.cloth->mesh, traj.x[f], rs, m);
+  else add_grid_cloth(*scene.cloth, traj.x[f], rs, m);
   for (const auto& c : scene.cloth->colliders) add_collider(m, c.shape, rs.collider_color);
   // Targets of the keyframes still to come, small beside their own spacing so a sheet of targets does
   // not hide the cloth that reaches it. A blend's end target (a whole other take's cape) is drawn at its

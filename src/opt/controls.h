@@ -26,7 +26,14 @@ class Controls {
   int size() const { return rigid_ ? 6 : blocks_ * block_size(); }
   // Force controls (per step, per frame, per frame on the lattice), not initial velocities.
   bool forces() const { return kind_ != ControlKind::kInitialVelocity; }
-  const char* kind() const { return control_kind_name(name_); }
+  // The scene's kind (its name: kind_name(), for logs and reports).
+  ControlKind kind() const { return name_; }
+  const char* kind_name() const { return control_kind_name(name_); }
+  // Initial velocities (per particle, rigid or on the lattice), not forces over time.
+  bool initial() const {
+    return name_ == ControlKind::kInitialVelocity || name_ == ControlKind::kInitialRigidVelocity ||
+           name_ == ControlKind::kInitialLatticeVelocity;
+  }
   // The starting point of the optimisation: no force, or the scene's initial velocities.
   VecX initial_guess() const;
   // z (size()) -> initial velocities v0 (3p) and per-step forces U (N entries of 3p, resized here).

@@ -119,6 +119,18 @@ struct Driver {
   }
 };
 
+StopReason stop_reason(nlopt::result r) {
+  switch (r) {
+    case nlopt::SUCCESS:
+    case nlopt::FTOL_REACHED:
+    case nlopt::XTOL_REACHED: return StopReason::kConverged;
+    case nlopt::STOPVAL_REACHED: return StopReason::kStopValue;
+    case nlopt::MAXEVAL_REACHED: return StopReason::kEvaluationLimit;
+    case nlopt::MAXTIME_REACHED: return StopReason::kTimeLimit;
+    default: return StopReason::kOther;
+  }
+}
+
 std::string status_name(nlopt::result r) {
   switch (r) {
     case nlopt::SUCCESS: return "converged";
@@ -129,6 +141,11 @@ std::string status_name(nlopt::result r) {
     case nlopt::MAXTIME_REACHED: return "time limit reached";
     default: return "stopped (" + std::to_string(int(r)) + ")";
   }
+}
+
+void set_stop(OptimizeResult& r, StopReason reason, std::string status) {
+  r.reason = reason;
+  r.status = std::move(status);
 }
 
 }  // namespace
@@ -144,7 +161,7 @@ OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX&
   if (spec.max_evaluations == 0 || n == 0) {
     std::vector<double> g(n);
     d(x, g);
-    d.result.status = "no optimisation requested";
+    set_stop(d.result, StopReason::kNotOptimised, "no optimisation requested");
   } else {
     // NLopt's LD_LBFGS ignores set_initial_step: its first trial step (and the first after each of its
     // internal restarts) is the whole negative gradient, 1e10 on sensitive cloth. Scaling the variables
@@ -174,22 +191,24 @@ OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX&
       if (spec.ftol_rel > 0) opt.set_ftol_rel(spec.ftol_rel);
       if (spec.max_seconds > 0) opt.set_maxtime(spec.max_seconds);
       opt.set_vector_storage(unsigned(spec.memory));
-      d.result.status = status_name(opt.optimize(x, f));
+      const nlopt::result r = opt.optimize(x, f);
+      set_stop(d.result, stop_reason(r), status_name(r));
     } catch (const nlopt::forced_stop&) {
-      d.result.status = "interrupted";
+      set_stop(d.result, StopReason::kInterrupted, "interrupted");
     } catch (const nlopt::roundoff_limited&) {
-      d.result.status = "converged (limited by round-off)";
+      set_stop(d.result, StopReason::kConverged, "converged (limited by round-off)");
     } catch (const std::runtime_error& e) {
       // LBFGS gives up this way when the line search cannot make progress; the best point stands.
-      d.result.status = std::string("stopped: line search made no progress (") + e.what() + ")";
+      set_stop(d.result, StopReason::kLineSearchStalled,
+               std::string("stopped: line search made no progress (") + e.what() + ")");
     }
     // NLopt may report a forced stop as a generic failure; what stopped it is known here. A stop asked for
     // during the evaluation NLopt ended on (its line search gave up, or it converged, without asking again)
     // is an interruption too: the run stops because it was told to, whatever NLopt said.
     if (stop && stop->load()) d.result.interrupted = true;
-    if (d.result.interrupted) d.result.status = "interrupted";
-    else if (d.result.reached) d.result.status = kKeyframesReached;
-    else if (d.limit_reached) d.result.status = status_name(nlopt::MAXEVAL_REACHED);
+    if (d.result.interrupted) set_stop(d.result, StopReason::kInterrupted, "interrupted");
+    else if (d.result.reached) set_stop(d.result, StopReason::kKeyframesReached, kKeyframesReached);
+    else if (d.limit_reached) set_stop(d.result, StopReason::kEvaluationLimit, status_name(nlopt::MAXEVAL_REACHED));
   }
   d.result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d.start).count();
   if (!std::isfinite(d.result.phi)) d.result.phi = problem.evaluate(d.result.z, nullptr);

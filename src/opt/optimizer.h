@@ -21,12 +21,30 @@ struct EvaluationRecord {
   std::vector<std::pair<std::string, double>> terms;
 };
 
+// Why an optimisation (or a strategy's stage) stopped. Decisions read this; `status` texts are for people.
+enum class StopReason {
+  kConverged,          // NLopt's success, ftol_rel, step tolerance or round-off
+  kStopValue,          // the objective fell below a stop value
+  kLineSearchStalled,  // L-BFGS's line search made no progress
+  kEvaluationLimit,
+  kTimeLimit,
+  kKeyframesReached,   // the stop rule said the best point meets every keyframe
+  kInterrupted,        // a signal asked the run to stop
+  kNotOptimised,       // no optimisation was asked for (no evaluations, or no controls)
+  kOther,              // another NLopt result (its code is in the status text)
+};
+// A budget ran out (evaluations or time).
+inline bool budget_spent(StopReason r) { return r == StopReason::kEvaluationLimit || r == StopReason::kTimeLimit; }
+// The optimisation ended on its own before its budget: it converged or its line search stalled.
+inline bool ended_early(StopReason r) { return r == StopReason::kConverged || r == StopReason::kLineSearchStalled; }
+
 struct OptimizeResult {
   VecX z;               // best point found
   double phi = 0;       // φ at z
   int evaluations = 0;
   double seconds = 0;
-  std::string status;   // why it stopped
+  StopReason reason = StopReason::kOther;  // why it stopped
+  std::string status;   // the same for people (NLopt's words)
   bool interrupted = false;
   int capped_trials = 0;  // trials refused unsimulated as farther than the reach left by an unstable one
   bool reached = false;   // stopped because `reached` said the best point meets the keyframes
@@ -38,7 +56,7 @@ struct OptimizeResult {
 // SIGINT/SIGTERM). With a `tape`, every evaluation is recorded on it, and evaluations it replays (an
 // interrupted run resumed) are taken from it instead of computed. `reached`, when given, is asked after each
 // simulated evaluation that improves on the best point (the problem's rollout is then that point's); true
-// ends the optimisation there, with status kKeyframesReached.
+// ends the optimisation there, with StopReason::kKeyframesReached.
 OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX& z0,
                         const std::function<void(const EvaluationRecord&)>& on_eval = {},
                         const std::atomic<bool>* stop = nullptr, EvaluationTape* tape = nullptr,

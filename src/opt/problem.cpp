@@ -26,7 +26,7 @@ Problem::Problem(const Scene& scene, const TimeSpec& time, System& sys)
 }
 
 double Problem::control_scale() const {
-  if (std::string(controls_.kind()).rfind("initial", 0) == 0) return 1.0;
+  if (controls_.initial()) return 1.0;
   const VecX& m = sys_.masses();
   // A flock feels no gravity: its own steering forces are about its mass times 1 m/s^2.
   const double acceleration = sys_.planar() ? 1.0 : 9.81;

@@ -27,7 +27,7 @@ int automatic_throw_count(int particles, int steps) {
 }
 
 ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted) {
-  if (problem.controls().kind() != std::string("initial_rigid_velocity"))
+  if (problem.controls().kind() != ControlKind::kInitialRigidVelocity)
     throw std::logic_error("search_throws: the problem's controls are not a rigid throw");
   VecX x0, v0;
   problem.system().initial_state(x0, v0);

@@ -66,16 +66,17 @@ std::string describe(const std::vector<StageSpec>& stages, int scene_from) {
 
 double gradient_growth(Problem& problem, const VecX& z, int reference) {
   const Controls& c = problem.controls();
-  const std::string kind = c.kind();
+  const ControlKind kind = c.kind();
   VecX g(problem.size());
   problem.evaluate(z, &g);
-  if (problem.last_diverged() || (kind != "per_step" && kind != "per_frame")) return 0;
+  if (problem.last_diverged() || (kind != ControlKind::kPerStep && kind != ControlKind::kPerFrame)) return 0;
+  const bool per_frame = kind == ControlKind::kPerFrame;
   const int substeps = problem.time().substeps, frames = problem.time().frames, first = c.first_frame();
-  const long stride = kind == "per_frame" ? g.size() / std::max(1, frames - first)
-                                          : g.size() / std::max(1, (frames - first) * substeps);
+  const long stride = per_frame ? g.size() / std::max(1, frames - first)
+                                : g.size() / std::max(1, (frames - first) * substeps);
   std::vector<double> sq(frames, 0.0);  // squared gradient norm of each frame's forces
   for (long b = 0; b * stride < g.size(); ++b) {
-    const int frame = first + int(kind == "per_frame" ? b : b / substeps);
+    const int frame = first + int(per_frame ? b : b / substeps);
     sq[std::min(frame, frames - 1)] += g.segment(b * stride, stride).squaredNorm();
   }
   const double largest = std::sqrt(*std::max_element(sq.begin(), sq.end()));
@@ -94,7 +95,7 @@ StagePlan plan_stages(const Scene& scene) {
   }
   plan.stages = {{scene.time.substeps, o.max_evaluations, std::nullopt}};  // the whole horizon at once
   plan.scaled_first_step = scene.flock.has_value();
-  if (o.strategy == "single" || !scene.cloth || o.max_evaluations < 2) return plan;
+  if (o.strategy == StagingStrategy::kSingle || !scene.cloth || o.max_evaluations < 2) return plan;
   const ControlSpec& c = scene.controls;
   if (c.kind == ControlKind::kInitialVelocity) {
     ControlSpec rigid = c;
@@ -107,7 +108,7 @@ StagePlan plan_stages(const Scene& scene) {
     if (lattice_budget > 0) plan.stages.push_back({scene.time.substeps, lattice_budget, lattice});
     plan.stages.push_back({scene.time.substeps, o.max_evaluations - rigid_budget - lattice_budget, std::nullopt});
     plan.throw_search = o.throw_search >= 0 ? o.throw_search
-                                            : automatic_throw_count(scene.cloth->nx * scene.cloth->ny, scene.time.steps());
+                                            : automatic_throw_count(scene.cloth->particles(), scene.time.steps());
     plan.why = "stages: a search over " + std::to_string(plan.throw_search) +
                " rigid throws, the best rigid throw (6 variables), a 3 x 3 lattice of initial velocities over the "
                "sheet from it, then one initial velocity per particle";

@@ -183,6 +183,16 @@ double target_squared_error(const ObjectiveSpec& o, const std::vector<Vec3>& tar
   return sum;
 }
 
+// The sheet's width at frame 0 (x0): a grid's first row's length; a mesh's largest extent along an axis.
+double sheet_width(const Scene& scene, const VecX& x0) {
+  if (!scene.cloth || !scene.cloth->mesh) {
+    const int nx = scene.cloth ? scene.cloth->nx : 1;
+    return (seg(x0, nx - 1) - seg(x0, 0)).norm();
+  }
+  const Eigen::Map<const Eigen::Matrix<double, 3, Eigen::Dynamic>> p(x0.data(), 3, x0.size() / 3);
+  return (p.rowwise().maxCoeff() - p.rowwise().minCoeff()).maxCoeff();
+}
+
 void position_measures(const Scene& scene, const ObjectiveSpec& o, const PositionKeyframe& k, const Trajectory& t,
                        int f, nlohmann::json& m) {
   if (scene.flock && o.particles.size() == 1) return race_measures(scene, o, k, t, f, m);
@@ -190,7 +200,7 @@ void position_measures(const Scene& scene, const ObjectiveSpec& o, const Positio
   const double sum = target_squared_error(o, k.targets, t.x[f], n);
   m["rms_error"] = std::sqrt(sum / n);
   if (scene.cloth) {
-    const double width = (seg(t.x[0], scene.cloth->nx - 1) - seg(t.x[0], 0)).norm();
+    const double width = sheet_width(scene, t.x[0]);
     m["rms_over_width"] = width > 0 ? std::sqrt(sum / n) / width : 0.0;
   }
 }
@@ -203,8 +213,7 @@ void arch_measures(const Scene& scene, const ArchKeyframe& k, const Trajectory& 
     const double e = (d - d.dot(k.axis) * k.axis).norm() - k.radius;
     sum += e * e;
   }
-  const int nx = scene.cloth ? scene.cloth->nx : 1;
-  const double width = (seg(t.x[0], nx - 1) - seg(t.x[0], 0)).norm();
+  const double width = sheet_width(scene, t.x[0]);
   m["rms_distance"] = std::sqrt(sum / p);
   m["width"] = width;
   m["rms_over_width"] = width > 0 ? std::sqrt(sum / p) / width : 0.0;
@@ -270,7 +279,7 @@ nlohmann::json figure_measures(const Scene& scene, const Trajectory& t) {
   visit_system(scene, Overloaded{
                           [](const FlockSpec&) {},
                           [&](const ClothSpec& cloth) {
-                            if (cloth.pins.empty()) out.push_back(sheet_measures(cloth, t));
+                            if (cloth.pins.empty() && !cloth.mesh) out.push_back(sheet_measures(cloth, t));
                             for (size_t k = 0; k < cloth.colliders.size(); ++k) {
                               nlohmann::json m = collider_measures(cloth, cloth.colliders[k], t);
                               if (m.is_null()) continue;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "scene/cloth_mesh_spec.h"
 #include "scene/params.h"
 #include "scene/particle_selector.h"
 
@@ -107,19 +108,30 @@ std::vector<int> named_pin_set(const std::string& name, int nx, int ny) {
   return out;
 }
 
-ClothSpec parse_cloth_spec(Block& b) {
+ClothSpec parse_cloth_spec(Block& b, const std::filesystem::path& directory) {
   ClothSpec s;
-  s.nx = b.integer("nx", s.nx, 2, 1024);
-  s.ny = b.integer("ny", s.ny, 2, 1024);
-  s.width = b.number("width", s.width, 1e-4, 1e4);
-  s.height = b.number("height", s.height, 1e-4, 1e4);
-  s.origin = b.vec3("origin", s.origin);
-  s.u_axis = unit_vec3(b, "u_axis", s.u_axis);
-  s.v_axis = unit_vec3(b, "v_axis", s.v_axis);
-  if (std::abs(s.u_axis.dot(s.v_axis)) > 1e-6) b.fail("v_axis", "expected a direction perpendicular to \"u_axis\"");
+  if (b.has("mesh")) {
+    s.mesh = parse_cloth_mesh(b.child("mesh"), directory);
+    s.mass_by_area = b.string("mass_by", "area", {"area", "uniform"}) == "area";
+  } else {
+    s.nx = b.integer("nx", s.nx, 2, 1024);
+    s.ny = b.integer("ny", s.ny, 2, 1024);
+    s.width = b.number("width", s.width, 1e-4, 1e4);
+    s.height = b.number("height", s.height, 1e-4, 1e4);
+    s.origin = b.vec3("origin", s.origin);
+    s.u_axis = unit_vec3(b, "u_axis", s.u_axis);
+    s.v_axis = unit_vec3(b, "v_axis", s.v_axis);
+    if (std::abs(s.u_axis.dot(s.v_axis)) > 1e-6) b.fail("v_axis", "expected a direction perpendicular to \"u_axis\"");
+  }
   s.mass = b.number("mass", s.mass, 1e-9, 1e6);
   const int p = s.particles();
-  if (b.has("pins") && b.json().at("pins").is_string()) {
+  if (b.has("pins") && is_rest_box(b.json().at("pins"))) {
+    Block region = b.child("pins");
+    s.pins = particles_in_region(region, s);
+  } else if (s.mesh && b.has("pins") && b.json().at("pins").is_string()) {
+    s.pins = {};
+    b.string("pins", "none", {"none"});  // the named edges are a grid's
+  } else if (b.has("pins") && b.json().at("pins").is_string()) {
     s.pins = named_pin_set(b.string("pins", "none", kPinSets), s.nx, s.ny);
   } else if (b.has("pins") && b.json().at("pins").is_object()) {
     s.pins = parse_particle_selector(b, "pins", p, &s);  // a row, a column, a rectangle of (i, j), a region

@@ -3,12 +3,15 @@
 // Particle (i, j), i = 0..nx-1 along the width (u_axis), j = 0..ny-1 along the height (v_axis), has
 // index j*nx + i. Named edges are by index: "bottom" is j = 0, "top" is j = ny-1, "left" is i = 0,
 // "right" is i = nx-1 (so with v_axis = +Y the top edge is the highest row).
+#include <filesystem>
+#include <memory>
 #include <string>
 #include <type_traits>
 #include <variant>
 #include <vector>
 
 #include "core/types.h"
+#include "scene/cloth_mesh.h"
 
 namespace kf {
 class Block;
@@ -60,6 +63,10 @@ inline const char* type_name(const ColliderSpec& c) {
 }
 
 struct ClothSpec {
+  // cloth.mesh (scene/cloth_mesh_spec.h): the sheet is this mesh, particle i its vertex i; null: the grid
+  // below, whose keys the scene then may not give.
+  std::shared_ptr<const ClothMesh> mesh;
+  bool mass_by_area = true;             // a mesh's particle masses: by the area of their faces (else even)
   int nx = 16, ny = 16;
   double width = 1.0, height = 1.0;     // metres, along u_axis and v_axis
   Vec3 origin = Vec3::Zero();           // position of particle (0, 0), metres
@@ -110,7 +117,7 @@ struct ClothSpec {
   double theta = 1.0;
   std::vector<ColliderSpec> colliders;
 
-  int particles() const { return nx * ny; }
+  int particles() const { return mesh ? mesh->particles() : nx * ny; }
   bool direct_solver() const { return solver == "direct"; }
   bool explicit_controls() const { return control_integration == "explicit"; }
   bool block_jacobi() const { return cg_preconditioner == "block_jacobi"; }
@@ -128,8 +135,9 @@ struct ClothSpec {
 
 // Reads the "cloth" block (every key range-checked, unknown keys are errors). "pins" is either an array
 // of particle indices or one named set: "none", "top_edge", "bottom_edge", "left_edge", "right_edge",
-// "top_corners", "bottom_corners", "corners".
-ClothSpec parse_cloth_spec(Block& b);
+// "top_corners", "bottom_corners", "corners" (a grid's), or a region (cloth_mesh_spec.h). `directory`: where
+// the path of a cloth.mesh file starts (the scene file's directory).
+ClothSpec parse_cloth_spec(Block& b, const std::filesystem::path& directory = {});
 
 // The particle indices of a named pin set for an nx x ny cloth (sorted). Throws std::invalid_argument on
 // an unknown name.

@@ -106,6 +106,10 @@ struct StageSpec {
   std::optional<ControlSpec> controls;  // empty: the scene's controls
 };
 
+// optimizer.split_schedule and optimizer.strategy, read once here (their names stay in src/scene/).
+enum class SplitSchedule { kHeld, kAdaptive };
+enum class StagingStrategy { kAuto, kSingle };
+
 struct OptimizerSpec {
   int max_evaluations = 300;  // each one forward + one adjoint pass
   double ftol_rel = 1e-8;
@@ -123,14 +127,14 @@ struct OptimizerSpec {
   // Cloth: "held" simulates each stage's start (and each restart's) once and repeats the split pattern its
   // energy check chose (ClothSystem::hold_schedule), so φ has no jumps where the check flips between
   // trial points; "adaptive" checks every step of every evaluation.
-  std::string split_schedule = "held";
+  SplitSchedule split_schedule = SplitSchedule::kHeld;
   // Cloth adjoint: "exact" (the transpose of the step's Jacobian) or "swap" (the paper's integrator swap).
   std::string adjoint = "exact";
   // How the run is split into stages when no schedule is given (opt/windows.h): "auto" keeps every
   // gradient short on cloth (forces over windows grown backwards from the last keyframe when the gradient
   // grows across the horizon; a rigid throw before per-particle initial velocities), "single" optimises
   // the scene's controls in one stage.
-  std::string strategy = "auto";
+  StagingStrategy strategy = StagingStrategy::kAuto;
   int window_frames = 5;  // the first window's length in frames; each next window is twice as long
   double window_growth = 1e3;  // windows when the start's force gradient grows more than this (or in contact: opt/windows.h)
   // RMS change per control variable of L-BFGS's first trial step (N for forces, m/s for velocities); a

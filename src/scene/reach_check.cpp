@@ -4,15 +4,13 @@
 #include <cstdio>
 
 #include "core/overloaded.h"
+#include "scene/cloth_mesh_spec.h"
 #include "scene/scene.h"
 
 namespace kf {
 namespace {
 
-Vec3 layout_position(const ClothSpec& c, int particle) {
-  const double dx = c.nx > 1 ? c.width / (c.nx - 1) : 0.0, dy = c.ny > 1 ? c.height / (c.ny - 1) : 0.0;
-  return c.origin + (particle % c.nx) * dx * c.u_axis + (particle / c.nx) * dy * c.v_axis;
-}
+Vec3 layout_position(const ClothSpec& c, int particle) { return cloth_rest_position(c, particle); }
 
 // A pinned particle's own target this close to it (metres) is where the pin holds it: targets are written
 // rounded (shapes.json's to 0.1 mm).

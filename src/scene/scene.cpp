@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/ground_region.h"
 #include "core/json_depth.h"
+#include "scene/cloth_mesh_spec.h"
 #include "scene/params.h"
 #include "scene/particle_selector.h"
 #include "scene/svg_shape_spec.h"
@@ -17,7 +18,7 @@ namespace kf {
 
 int Scene::particles() const {
   if (flock) return flock->agents;
-  if (cloth) return cloth->nx * cloth->ny;
+  if (cloth) return cloth->particles();
   return 0;
 }
 
@@ -219,7 +220,12 @@ ObjectiveSpec parse_objective(Block b, const Scene& s) {
   o.frame = b.integer("frame", 0, s.time.frames);
   o.weight = b.number("weight", 1.0, 0.0, 1e12);
   const int p = s.particles();
-  if (b.has("particles")) o.particles = parse_particle_selector(b, "particles", p, s.cloth ? &*s.cloth : nullptr);
+  if (b.has("particles") && s.cloth && is_rest_box(b.json().at("particles"))) {
+    Block region = b.child("particles");
+    o.particles = particles_in_region(region, *s.cloth);
+  } else if (b.has("particles")) {
+    o.particles = parse_particle_selector(b, "particles", p, s.cloth ? &*s.cloth : nullptr);
+  }
   for (const ObjectiveType& t : kObjectiveTypes)
     if (type == t.name) o.kind = t.parse(b, o, s);
   b.finish();
@@ -288,9 +294,14 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls, int fr
   o.max_memory = b.number("max_memory", o.max_memory, 0.0, 1e6);
   o.restarts = b.integer("restarts", o.restarts, 0, 1000);
   if (b.has("throw_search")) o.throw_search = b.integer("throw_search", 0, 0, 100000);
-  o.split_schedule = b.string("split_schedule", o.split_schedule, {"held", "adaptive"});
+  o.split_schedule = b.string("split_schedule", o.split_schedule == SplitSchedule::kHeld ? "held" : "adaptive",
+                               {"held", "adaptive"}) == "held"
+                         ? SplitSchedule::kHeld
+                         : SplitSchedule::kAdaptive;
   o.adjoint = b.string("adjoint", o.adjoint, {"exact", "swap"});
-  o.strategy = b.string("strategy", o.strategy, {"auto", "single"});
+  o.strategy = b.string("strategy", o.strategy == StagingStrategy::kAuto ? "auto" : "single", {"auto", "single"}) == "auto"
+                   ? StagingStrategy::kAuto
+                   : StagingStrategy::kSingle;
   o.window_frames = b.integer("window_frames", o.window_frames, 1, 1'000'000);
   o.window_growth = b.number("window_growth", o.window_growth, 1.0, 1e300);
   if (b.has("first_step")) o.first_step = b.number("first_step", 0.0, 0.0, 1e12);
@@ -336,7 +347,7 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& file, Pa
     s.flock = parse_flock_spec(b);
   } else {
     Block b = root.child("cloth");
-    s.cloth = parse_cloth_spec(b);
+    s.cloth = parse_cloth_spec(b, s.directory);
   }
   if (root.has("character")) s.character = parse_character_spec(root.child("character"), s);
   for (Block& b : root.array("objectives")) s.objectives.push_back(parse_objective(std::move(b), s));

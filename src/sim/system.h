@@ -14,6 +14,25 @@
 
 namespace kf {
 
+// The discrete decisions a system's steps took (the cloth: which steps its energy check split, and how),
+// kept by the optimisation strategy and handed back so later runs repeat them: a rollout is then a smooth
+// function of the controls. Opaque outside the system that made it; empty when there are none.
+class StepSchedule {
+ public:
+  struct Pattern {
+    virtual ~Pattern() = default;
+    virtual int steps() const = 0;  // the steps it covers
+  };
+  StepSchedule() = default;
+  explicit StepSchedule(std::shared_ptr<const Pattern> p) : p_(std::move(p)) {}
+  bool empty() const { return !p_; }
+  int steps() const { return p_ ? p_->steps() : 0; }
+  const Pattern* pattern() const { return p_.get(); }
+
+ private:
+  std::shared_ptr<const Pattern> p_;
+};
+
 // What one forward step leaves for its adjoint: one entry of a rollout's tape. Each system derives its own
 // (the cloth keeps the step's velocity change, the flock its neighbour lists); the base records nothing.
 struct StepRecord {
@@ -81,6 +100,13 @@ class System {
   // Why the last step that returned false failed, with what would help, in the scene's words; empty when
   // it only met values that are not finite.
   virtual std::string divergence_reason() const { return {}; }
+
+  // The step decisions of the runs so far (step_schedule), held so that every later run repeats them
+  // (hold_step_schedule; steps past its end decide afresh) until released. Systems that decide nothing
+  // return an empty schedule and ignore the rest.
+  virtual StepSchedule step_schedule() const { return {}; }
+  virtual void hold_step_schedule(const StepSchedule& /*schedule*/) {}
+  virtual void release_step_schedule() {}
 
   // Named counters of the last forward simulation for run reports (a cape's collision contacts).
   virtual std::vector<std::pair<std::string, double>> run_stats() const { return {}; }

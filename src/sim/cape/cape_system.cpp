@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "core/error.h"
 #include "core/warnings.h"
 #include "sim/cape/anchor_track.h"
 #include "sim/character/cape_anchors.h"
@@ -50,6 +51,7 @@ void warn_if_pins_jump(const ClothSpec& c, const std::vector<Vec3>& anchors, con
 CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, double fps, int steps, double h)
     : spec_(character), fps_(fps), h_(h), character_(load_character(character, int(std::lround(steps * h * fps)))),
       cape_length_(cloth.height) {
+  if (cloth.mesh) throw InputError(cloth.mesh->file + ": a cape on a character is a grid cloth (cloth.mesh is not for capes yet)");
   ClothSpec c = cloth;
   c.pins = named_pin_set("top_edge", c.nx, c.ny);
   // The moving body does work on the cape that a step's energy check cannot account for, so cape steps

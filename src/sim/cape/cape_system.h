@@ -41,6 +41,10 @@ class CapeSystem final : public System {
   // The cloth's PCG warm start, so checkpointed rollouts recompute cape steps bit for bit.
   void save_step_context(int n, VecX& context) const override { cloth_->save_step_context(n, context); }
   void restore_step_context(int n, const VecX& context) override { cloth_->restore_step_context(n, context); }
+  // The cloth's split pattern (sim/system.h's step schedule).
+  StepSchedule step_schedule() const override { return cloth_->step_schedule(); }
+  void hold_step_schedule(const StepSchedule& schedule) override { cloth_->hold_step_schedule(schedule); }
+  void release_step_schedule() override { cloth_->release_step_schedule(); }
   std::string describe() const override;
   // Contacts of the last forward run: body_contacts (particle-steps), self_contacts (pair-steps),
   // max_body_contacts / max_self_contacts (in one step), contact_steps, cape_length (m),

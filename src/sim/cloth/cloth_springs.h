@@ -25,8 +25,13 @@ struct ClothSprings {
   std::vector<Incident> incident;
 };
 
-// The springs of the spec's nx x ny grid with rest lengths from x0 (3p, metres), the incidence with
-// slots unset (-1).
+// The springs of the spec's nx x ny grid, or of its mesh (mesh_springs.h), with rest lengths from x0 (3p,
+// metres), the incidence with slots unset (-1).
 ClothSprings make_cloth_springs(const ClothSpec& spec, const VecX& x0);
+
+// A spring from a to b of stiffness k in tension, rest length from x0, the spec's Choi-Ko response.
+BucklingSpring make_buckling_spring(const ClothSpec& spec, const VecX& x0, int a, int b, double k);
+// Fills out.incident_start and out.incident from out.list for p particles.
+void set_incidence(ClothSprings& out, int p);
 
 }  // namespace kf

@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "sim/cloth/imperfection.h"
+#include "sim/cloth/mesh_layout.h"
 #include "sim/make_system.h"
 
 namespace kf {
@@ -47,6 +48,7 @@ AdjointKind adjoint_kind(const std::string& name) {
 namespace {
 // The grid's positions at rest (3p, metres).
 VecX rest_positions(const ClothSpec& spec) {
+  if (spec.mesh) return mesh_rest_positions(spec);
   const double dx = spec.width / (spec.nx - 1), dy = spec.height / (spec.ny - 1);
   VecX x0(3 * spec.particles());
   for (int j = 0; j < spec.ny; ++j)
@@ -73,7 +75,8 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
       colliders_(all_colliders(spec, std::move(extra_colliders))),
       assembly_(spec, x0_, colliders_),
       pins_(pins ? std::move(pins) : std::make_unique<StaticPins>()) {
-  mass_.setConstant(p_, spec.mass / p_);
+  if (spec.mesh) mass_ = mesh_masses(spec);
+  else mass_.setConstant(p_, spec.mass / p_);
   free_.assign(p_, 1);
   for (int i : spec.pins) {
     if (i < 0 || i >= p_) throw InputError("cloth: pinned particle " + std::to_string(i) + " does not exist");
@@ -95,7 +98,9 @@ ClothSystem::ClothSystem(const ClothSpec& spec, double h, std::unique_ptr<PinTra
   direct_solve_ = spec.direct_solver();
   split_x_.resize(spec.max_halvings);
   split_v_.resize(spec.max_halvings);
-  pcg_.resize(p_, preconditioner_kind(spec.cg_preconditioner, p_), spec.nx, spec.ny);
+  // Multigrid is the grid's: a mesh cloth's PCG uses IC(0) (or block Jacobi) whatever the scene asks.
+  if (spec.mesh) pcg_.resize(p_, spec.block_jacobi() ? Preconditioner::kBlockJacobi : Preconditioner::kIncompleteCholesky);
+  else pcg_.resize(p_, preconditioner_kind(spec.cg_preconditioner, p_), spec.nx, spec.ny);
   // IC(0) leaves out the bending springs' blocks: with the default stiffnesses they are a hundredth of the
   // stretch springs' and they reach two grid rows, so they made half the factor's blocks and a separator twice
   // as wide for a few per cent fewer iterations.
@@ -230,61 +235,6 @@ void ClothSystem::accept_substep(int depth, double t0, const VecX& x, const VecX
   }
 }
 
-bool ClothSystem::held_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u,
-                            VecX& x_next, VecX& v_next, ClothRecord& rec, const std::vector<std::uint8_t>& pattern) {
-  if (cursor_ >= pattern.size() || pattern[cursor_] < depth) return false;  // not a pattern a run recorded
-  if (pattern[cursor_] == depth) {
-    ++cursor_;
-    if (!linear_step(n, depth, t0, x, v, u, x_next, v_next)) return false;
-    accept_substep(depth, t0, x, v, rec);
-    return true;
-  }
-  if (depth >= spec_.max_halvings) return false;
-  VecX &xm = split_x_[depth], &vm = split_v_[depth];
-  xm.resize(3 * p_);
-  vm.resize(3 * p_);
-  const double half = std::ldexp(1.0, -depth - 1);
-  return held_step(n, depth + 1, t0, x, v, u, xm, vm, rec, pattern) &&
-         held_step(n, depth + 1, t0 + half, xm, vm, u, x_next, v_next, rec, pattern);
-}
-
-bool ClothSystem::checked_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u,
-                               VecX& x_next, VecX& v_next, ClothRecord& rec) {
-  const bool solved = linear_step(n, depth, t0, x, v, u, x_next, v_next);
-  bool accept = solved;
-  if (depth < spec_.max_halvings) {
-    // Backward Euler with damping never gains energy; the linearised step does when it moves particles
-    // fast across springs or into colliders, and halving the step shrinks what it invents ~4-16 times.
-    // An explicit control's kick is external to the solve (it may store more spring energy than its
-    // work in one step): the check measures the solve's own end state.
-    const bool kick = spec_.explicit_controls();
-    if (kick && solved) {
-      solved_v_ = v + dv_ / spec_.theta;
-      solved_x_ = x + std::ldexp(h_, -depth) * (v + dv_);
-    }
-    const VecX& xc = kick ? solved_x_ : x_next;
-    const VecX& vc = kick ? solved_v_ : v_next;
-    const Energy before = energy_at_start(n, x, v), after = solved ? energy(n, xc, vc) : Energy{};
-    const double work = solved ? external_work(u, x, xc, !kick) : 0.0;
-    // The energy the step moves is the tolerance's scale (a NaN gain fails the test and splits).
-    const double moved = before.kinetic + before.elastic + before.contact + std::abs(work) +
-                         std::abs(after.gravity - before.gravity);
-    accept = solved && after.total() - before.total() - work <= 1e-3 * moved + 1e-12;
-    if (accept && !kick) remember_energy(x_next, v_next, after);
-  }
-  if (accept) {
-    accept_substep(depth, t0, x, v, rec);
-    return true;
-  }
-  if (depth >= spec_.max_halvings) return false;
-  VecX &xm = split_x_[depth], &vm = split_v_[depth];  // sized for every depth up front: no reallocation here
-  xm.resize(3 * p_);
-  vm.resize(3 * p_);
-  const double half = std::ldexp(1.0, -depth - 1);
-  return checked_step(n, depth + 1, t0, x, v, u, xm, vm, rec) &&
-         checked_step(n, depth + 1, t0 + half, xm, vm, u, x_next, v_next, rec);
-}
-
 bool ClothSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX& x_next, VecX& v_next,
                        StepRecord& record) {
   ClothRecord& rec = static_cast<ClothRecord&>(record);
@@ -299,13 +249,7 @@ bool ClothSystem::step(int n, const VecX& x, const VecX& v, const VecX& u, VecX&
     step_substeps_.resize(n + 1, 0);
     step_cg_.resize(n + 1, 0);
   }
-  if (!holding_) {
-    if (n >= int(recorded_.size())) recorded_.resize(n + 1);
-    auto& pattern = recorded_[n];
-    pattern.clear();  // keeps its capacity: a run after the first allocates nothing here
-    if (ok)
-      for (int k = 0; k < rec.count; ++k) pattern.push_back(std::uint8_t(rec.substeps[k].depth));
-  }
+  if (!holding_) record_pattern(n, ok, rec);
   step_substeps_[n] = ok ? rec.count : 0;
   step_cg_[n] = last_cg_;
   // The next step starts warm only from an unsplit step's solution.
@@ -413,9 +357,9 @@ void ClothSystem::restore_step_context(int n, const VecX& context) { forward_sta
 std::string ClothSystem::describe() const {
   std::ostringstream os, tolerance;
   tolerance << spec_.cg_tolerance;
-  os << "cloth: " << spec_.nx << "x" << spec_.ny << " particles, " << assembly_.springs().list.size() << " springs, "
+  os << "cloth: " << (spec_.mesh ? std::to_string(p_) + " mesh" : std::to_string(spec_.nx) + "x" + std::to_string(spec_.ny)) << " particles, " << assembly_.springs().list.size() << " springs, "
      << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, "
-     << (direct_solve_ ? std::string("sparse ") + FilteredDirect::backend() : std::string("PCG (") + preconditioner_name(preconditioner_kind(spec_.cg_preconditioner, p_)) + ", tolerance " + tolerance.str() + ")") << ", " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
+     << (direct_solve_ ? std::string("sparse ") + FilteredDirect::backend() : std::string("PCG (") + preconditioner_name(spec_.mesh && !spec_.block_jacobi() ? Preconditioner::kIncompleteCholesky : preconditioner_kind(spec_.cg_preconditioner, p_)) + ", tolerance " + tolerance.str() + ")") << ", " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
   if (spec_.theta != 1) os << ", theta " << spec_.theta << " step";
   return os.str();
 }

@@ -102,6 +102,10 @@ class ClothSystem final : public System {
     holding_ = true;
   }
   void release_schedule() { holding_ = false; }
+  // The same through the System hook (the split pattern type-erased; defined in cloth_split_steps.cpp).
+  kf::StepSchedule step_schedule() const override;
+  void hold_step_schedule(const kf::StepSchedule& schedule) override;
+  void release_step_schedule() override { release_schedule(); }
 
   void set_adjoint(AdjointKind kind) { adjoint_ = kind; }
   AdjointKind adjoint() const { return adjoint_; }
@@ -146,6 +150,8 @@ class ClothSystem final : public System {
   // The (sub)step as the held pattern `pattern` says from its entry cursor_ on: taken whole, or halved.
   bool held_step(int n, int depth, double t0, const VecX& x, const VecX& v, const VecX& u, VecX& x_next,
                  VecX& v_next, ClothRecord& rec, const std::vector<std::uint8_t>& pattern);
+  // Records the depths of step n's accepted substeps in recorded_ (none when it failed).
+  void record_pattern(int n, bool ok, const ClothRecord& rec);
   // Appends the substep just solved (dv_) to `rec`.
   void accept_substep(int depth, double t0, const VecX& x, const VecX& v, ClothRecord& rec);
   // The adjoint of one linearised substep (see the header comment); adds its uhat to `uhat`.
