@@ -68,6 +68,8 @@ void absolutise_scene_paths(nlohmann::json& j, const fs::path& scene_dir) {
     if (c.contains("start")) absolutise(c["start"], "run");
     if (c.contains("end_target")) absolutise(c["end_target"], "run");
   }
+  // A cloth's mesh file.
+  if (j.contains("cloth") && j["cloth"].is_object() && j["cloth"].contains("mesh")) absolutise(j["cloth"]["mesh"], "file");
   // And a shape keyframe's SVG file.
   if (j.contains("objectives") && j["objectives"].is_array())
     for (auto& o : j["objectives"])

@@ -88,14 +88,18 @@ const std::vector<std::string>& named_particle_sets() {
 std::vector<int> parse_particle_selector(Block& b, const std::string& key, int particles, const ClothSpec* sheet) {
   const Json& j = b.json().at(key);
   std::vector<int> out;
-  const bool grid = sheet && !sheet->mesh;  // rows, columns and named edges are a grid's
-  if (j.is_string()) {
-    const std::string name = b.string(key, grid ? named_particle_sets() : std::vector<std::string>{"all"});
-    if (grid) out = named_set(name, sheet->nx, sheet->ny);
-  } else if (j.is_object() && grid) {
+  if (sheet && sheet->mesh && !j.is_array()) {  // rows, columns and named edges are a grid's
+    if (j.is_object()) b.fail(key, "expected vertex indices, \"all\" or a rest-space box {\"min\", \"max\"} (a mesh cloth)");
+    b.string(key, std::vector<std::string>{"all"});
+    for (int i = 0; i < particles; ++i) out.push_back(i);
+  } else if (j.is_string()) {
+    const std::string name =
+        b.string(key, sheet ? named_particle_sets() : std::vector<std::string>{"all"});
+    if (sheet) out = named_set(name, sheet->nx, sheet->ny);
+  } else if (j.is_object() && sheet) {
     out = object_set(b.child(key), *sheet, key, b);
   } else if (j.is_object()) {
-    b.fail(key, "expected particle indices or \"all\" (rows, columns and regions select a grid cloth's particles)");
+    b.fail(key, "expected particle indices or \"all\" (rows, columns and regions select a cloth's particles)");
   } else {
     out = b.integers(key, 1, 0, particles - 1);
   }
@@ -105,7 +109,7 @@ std::vector<int> parse_particle_selector(Block& b, const std::string& key, int p
 }
 
 Vec3 rest_position(const ClothSpec& c, int index) {
-  if (c.mesh) return c.mesh->vertices[size_t(index)];  // a sheet from a mesh rests as the mesh
+  if (c.mesh) return c.mesh->vertices[size_t(index)];
   const int i = index % c.nx, j = index / c.nx;
   return c.origin + i * (c.width / (c.nx - 1)) * c.u_axis + j * (c.height / (c.ny - 1)) * c.v_axis;
 }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "app/run_dir.h"
 #include "core/error.h"
 #include "opt/problem.h"
 #include "scene/cloth_mesh_spec.h"
@@ -150,18 +151,20 @@ TEST(ClothMeshAdjoint, MatchesFiniteDifferencesInContactAtPerturbedControls) {
       {"ground_sliding_lattice",
        R"("velocity": [1.5, -0.05, 0.4],
           "colliders": [{"type": "ground", "center": [0, 0.11, 0], "thickness": 0.03, "stiffness": 3000, "friction": 0.6}])",
-       R"({"kind": "per_frame_lattice", "alpha": 1e-4})",
+       R"({"kind": "per_frame", "alpha": 1e-4})",
        R"([{"type": "position", "frame": 3, "weight": 100, "particles": {"min": [-1, -1, -1], "max": [0, 1, 0]},
             "targets": [[0.1, 0.15, 0.1]]}])"},
   };
   for (const Case& c : cases) {
     const std::string& cloth = c.cloth;
     for (int substeps : {1, 4}) {
-      const Scene scene = parse_scene(
+      Scene scene = parse_scene(
           std::string(R"({"time": {"fps": 30, "frames": 3, "substeps": )") + std::to_string(substeps) +
               R"(}, "cloth": {"mesh": {"file": ")" + file.string() + R"("}, "mass": 0.1, "solver": "direct", )" + cloth +
               R"(}, "controls": )" + c.controls + R"(, "objectives": )" + c.objectives + "}",
           dir.path() / (std::string(c.name) + ".json"));
+      // Forces on the 3 x 3 lattice over the mesh (a stage's controls, not a scene's).
+      if (std::string(c.name).ends_with("lattice")) scene.controls.kind = ControlKind::kPerFrameLattice;
       auto sys = make_system(scene);
       Problem problem(scene, scene.time, *sys);
       test::gradcheck_perturbed(problem, 1e-4, {0.0, 0.01, 0.1}, [&](double perturb, const GradcheckResult& r) {
@@ -243,6 +246,13 @@ TEST(ClothMeshSpec, PinsAndKeyframeParticlesByRegionOfTheRestShape) {
   EXPECT_LT(s.cloth->pins.size(), 35u);
   ASSERT_FALSE(s.objectives[0].particles.empty());
   for (int i : s.objectives[0].particles) EXPECT_GE(s.cloth->mesh->vertices[size_t(i)].x(), 0.5);
+}
+
+// A run directory's copy of the scene names the mesh file absolutely, so render and export read it there.
+TEST(ClothMeshSpec, ARunsSceneCopyNamesTheMeshFileAbsolutely) {
+  nlohmann::json j = nlohmann::json::parse(R"({"cloth": {"mesh": {"file": "../assets/cloth/flag.obj"}}})");
+  absolutise_scene_paths(j, "/data/shots/scenes");
+  EXPECT_EQ(j["cloth"]["mesh"]["file"], "/data/shots/assets/cloth/flag.obj");
 }
 
 std::string load_error(const std::string& text, const std::filesystem::path& file) {
