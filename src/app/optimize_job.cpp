@@ -123,7 +123,7 @@ StrategyHooks job_hooks(const Scene& scene, const OptimizeOptions& opt, std::uin
 // result as if it had not stopped); an older one continues its last stage from controls.bin.
 void prepare_resume(const fs::path& dir, StrategySetup& setup) {
   if (fs::exists(dir / "evaluations.bin")) {
-    setup.tape.set_replay(load_evaluations(dir / "evaluations.bin"));
+    setup.tape.set_replay(load_evaluations(dir / "evaluations.bin"), dir / "evaluations.bin");
     return;
   }
   setup.start = load_controls(dir / "controls.bin", &setup.start_time.substeps);
@@ -147,9 +147,17 @@ void say_outcome(const OptimizeOptions& opt, const fs::path& dir, const Optimize
   if (opt.quiet && !job.interrupted && !run.diagnosis.failed()) std::cout << run.diagnosis.line << std::endl;
 }
 
+// A signal before the first evaluation: nothing is written (the staging directory goes with its owner).
+OptimizeOutcome interrupted_before_evaluating(const fs::path& dir) {
+  std::cerr << "keyframe: interrupted before the first evaluation: nothing written to " << dir.string() << "\n";
+  return {dir, true, false, ""};
+}
+
 }  // namespace
 
 OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& opt) {
+  // From the start: planning, the growth probe and the throw search take time too.
+  SignalGuard signals;
   const bool resuming = !opt.resume.empty();
   const Scene scene = job_scene(scene_file, opt);
   const fs::path dir = resuming ? fs::path(opt.resume) : run_dir_for(scene, opt.out);
@@ -175,6 +183,7 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   setup.system = make_system(scene, first.h());
   // The new run is written beside the old one and swapped in at the end (locked meanwhile), so a failed or
   // killed job leaves an existing run directory as it was.
+  if (g_stop) return interrupted_before_evaluating(dir);
   StagedDir staged(dir);
   const fs::path work = staged.path();
   if (resuming) staged.copy_from_target([](const std::string&) { return true; });
@@ -182,9 +191,9 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
 
   EvaluationLog elog(opt.quiet, "optimize " + scene.name);
   if (!setup.plan.why.empty() && !resuming) elog.say(setup.plan.why);
-  SignalGuard signals;
   OptimizeRun run;
   run.strategy = run_strategy(std::move(setup), job_hooks(scene, opt, max_memory, run), elog);
+  if (run.strategy.interrupted && run.strategy.evaluations == 0) return interrupted_before_evaluating(dir);
 
   nlohmann::json report;
   naming_run_dir(staged, [&] { report = write_run_report(work, scene, resuming, run, elog); });
@@ -193,7 +202,9 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
     write_file_atomic(w / (resuming ? "log_resumed.txt" : "log.txt"), elog.text());
   });
   const StrategyResult& r = run.strategy;
-  return {dir, r.interrupted, !r.interrupted && run.diagnosis.failed(), run.diagnosis.line};
+  // A signal after the last evaluation stops nothing, but the run still exits as interrupted.
+  const bool interrupted = r.interrupted || g_stop;
+  return {dir, interrupted, !interrupted && run.diagnosis.failed(), run.diagnosis.line};
 }
 
 }  // namespace kf

@@ -91,7 +91,7 @@ void write_run_files(const fs::path& dir, const Scene& scene, const StrategyResu
                      const EvaluationLog& elog) {
   save_controls(dir / "controls.bin", job.z, job.time.substeps);
   std::error_code ec;
-  if (job.tape.complete()) save_evaluations(dir / "evaluations.bin", job.tape.records());
+  if (job.tape.complete()) save_evaluations(dir / "evaluations.bin", job.tape.contents());
   else fs::remove(dir / "evaluations.bin", ec);  // too large to keep: a resume restarts from controls.bin
   save_trajectory(dir / "trajectory.bin", frames);
   write_body_meshes(scene, frames.frames(), dir / "meshes.bin");

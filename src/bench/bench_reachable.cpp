@@ -2,6 +2,10 @@
 // its default settings and judged by its keyframes (opt/diagnosis.h), a table a scene and one a class.
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
+#include <csignal>
+#include <mutex>
+#include <thread>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -42,10 +46,88 @@ bool wanted(const ReachableSweepOptions& o, const std::string& name) {
   return false;
 }
 
+extern "C" void ignore_signal(int) {}
+
+// Stops the optimize job running in this process after `seconds` (SIGHUP, which the job answers by saving
+// its best point and writing its run directory), unless it ended first. Between jobs the bench ignores
+// SIGHUP, so a stop that arrives as a job ends does no harm.
+class JobDeadline {
+ public:
+  explicit JobDeadline(double seconds)
+      : timer_([this, seconds] {
+          std::unique_lock<std::mutex> lock(m_);
+          if (!cv_.wait_for(lock, std::chrono::duration<double>(seconds), [this] { return done_; })) {
+            fired_ = true;
+            std::raise(SIGHUP);
+          }
+        }) {}
+  ~JobDeadline() {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      done_ = true;
+    }
+    cv_.notify_all();
+    timer_.join();
+  }
+  bool fired() {
+    std::lock_guard<std::mutex> lock(m_);
+    return fired_;
+  }
+
+ private:
+  std::mutex m_;
+  std::condition_variable cv_;
+  bool done_ = false, fired_ = false;
+  std::thread timer_;
+};
+
 struct ClassTally {
   int scenes = 0, passed = 0;
   std::vector<double> evaluations, seconds;
 };
+
+// One scene's optimize job, cut at the pass time, and its report (copied to out/reports/).
+struct SceneRun {
+  OptimizeOutcome outcome;
+  nlohmann::json report;
+  bool cut = false;
+  double seconds = 0;
+};
+
+SceneRun run_scene(const ReachableSweepOptions& o, const std::string& name, const std::filesystem::path& file,
+                   const std::filesystem::path& out) {
+  OptimizeOptions opt;
+  opt.out = (o.runs_dir / name).string();
+  opt.quiet = true;
+  opt.max_seconds = o.max_seconds;
+  std::cerr << "bench reachable: " << name << " (load " << load_average() << ")" << std::endl;
+  SceneRun run;
+  const auto start = std::chrono::steady_clock::now();
+  {
+    JobDeadline deadline(o.pass_seconds);
+    run.outcome = optimize_job(file, opt);
+    run.cut = deadline.fired();
+  }
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::ifstream in(run.outcome.dir / "report.json");
+  run.report = nlohmann::json::parse(in);
+  write_file_atomic(out / "reports" / (name + ".json"), run.report.dump(1) + "\n");
+  return run;
+}
+
+// reachable_classes.csv (pass rate, median evaluations, median and worst seconds a class) and its plot.
+void write_class_table(const std::map<std::string, ClassTally>& tally, int rows, const std::filesystem::path& out) {
+  CsvTable classes({"class", "scenes", "passed", "pass_rate", "median_evaluations", "median_seconds", "worst_seconds"});
+  for (const auto& [kind, c] : tally)
+    classes.add({kind, std::to_string(c.scenes), std::to_string(c.passed), fmt(double(c.passed) / c.scenes),
+                 fmt(median(c.evaluations)), fmt(median(c.seconds)),
+                 fmt(*std::max_element(c.seconds.begin(), c.seconds.end()))});
+  classes.write(out / "reachable_classes.csv");
+  if (rows > 0)
+    bar_plot_csv(out / "reachable_classes.csv", out / "reachable.png", "pass rate by class (1: every scene passed)",
+                 {classes.col("class")}, {classes.col("pass_rate")}, false);
+  std::cout << classes.excerpt(100) << std::endl;
+}
 
 }  // namespace
 
@@ -55,6 +137,7 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
   nlohmann::json summary = {{"seed", o.seed}, {"load_before", load_average()}};
   std::map<std::string, ClassTally> tally;
   ensure_directory(o.scene_dir);
+  std::signal(SIGHUP, ignore_signal);
   ensure_directory(out / "reports");
   int passed = 0, rows = 0;
   for (const auto& [name, kind] : reachable_suite(o)) {
@@ -64,24 +147,17 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
     const ReachableScene r = generate_reachable(kind, o.seed, index, false, o.scene_dir);
     write_file_atomic(file, r.scene.dump(1) + "\n");
     if (o.generate_only) continue;
-    OptimizeOptions opt;
-    opt.out = (o.runs_dir / name).string();
-    opt.quiet = true;
-    opt.max_seconds = o.max_seconds;
-    std::cerr << "bench reachable: " << name << " (load " << load_average() << ")" << std::endl;
-    const auto start = std::chrono::steady_clock::now();
-    const OptimizeOutcome outcome = optimize_job(file, opt);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::ifstream in(outcome.dir / "report.json");
-    const nlohmann::json report = nlohmann::json::parse(in);
-    write_file_atomic(out / "reports" / (name + ".json"), report.dump(1) + "\n");
+    const SceneRun run = run_scene(o, name, file, out);
+    const nlohmann::json& report = run.report;
+    const bool cut = run.cut;
+    const double seconds = run.seconds;
     const nlohmann::json* worst = nullptr;
     for (const auto& k : report.at("keyframe_errors"))
       if (k.at("judged").get<bool>() &&
           (!worst || k.at("miss_after").get<double>() > worst->at("miss_after").get<double>()))
         worst = &k;
     if (!worst) continue;
-    const bool pass = report.at("diagnosis").at("reached").get<bool>() && seconds <= o.pass_seconds;
+    const bool pass = !cut && report.at("diagnosis").at("reached").get<bool>() && seconds <= o.pass_seconds;
     const int evaluations = report.at("evaluations").get<int>();
     passed += pass;
     ++rows;
@@ -92,29 +168,22 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
     c.seconds.push_back(seconds);
     t.add({name, kind, std::to_string(r.keyframes), r.friction ? "yes" : "no", r.thrown ? "yes" : "no",
            r.character ? "yes" : "no", r.scene.at("controls").at("kind").get<std::string>(),
-           std::to_string(report.contains("particles") ? report.at("particles").get<int>() : 0),
+           std::to_string(r.scene.contains("flock") ? r.scene["flock"]["agents"].get<int>()
+                                                    : r.scene["cloth"]["nx"].get<int>() * r.scene["cloth"]["ny"].get<int>()),
            worst->at("name").get<std::string>(), fmt(worst->at("miss_before").get<double>()),
            fmt(worst->at("miss_after").get<double>()), std::to_string(evaluations), fmt(seconds),
-           report.at("diagnosis").at("outcome").get<std::string>(), pass ? "yes" : "no"});
+           cut ? "cut" : report.at("diagnosis").at("outcome").get<std::string>(), pass ? "yes" : "no"});
     t.write(out / "reachable.csv");  // after every scene: a cut-off run keeps what it measured
-    summary["diagnoses"][name] = outcome.diagnosis;
+    summary["diagnoses"][name] = run.outcome.diagnosis;
   }
   if (o.generate_only) return summary;
-  CsvTable classes({"class", "scenes", "passed", "pass_rate", "median_evaluations", "median_seconds", "worst_seconds"});
-  for (const auto& [kind, c] : tally)
-    classes.add({kind, std::to_string(c.scenes), std::to_string(c.passed), fmt(double(c.passed) / c.scenes),
-                 fmt(median(c.evaluations)), fmt(median(c.seconds)),
-                 fmt(*std::max_element(c.seconds.begin(), c.seconds.end()))});
-  classes.write(out / "reachable_classes.csv");
-  if (rows > 0)
-    bar_plot_csv(out / "reachable_classes.csv", out / "reachable.png", "pass rate by class (1: every scene passed)",
-                 {classes.col("class")}, {classes.col("pass_rate")}, false);
+  write_class_table(tally, rows, out);
   summary["load_after"] = load_average();
   summary["passed"] = passed;
   summary["scenes"] = rows;
   write_file_atomic(out / "load.txt", "load average (1, 5, 15 min) before: " + summary["load_before"].get<std::string>() +
                                           "\nafter: " + summary["load_after"].get<std::string>() + "\n");
-  std::cout << "reachable.csv: " << passed << " of " << rows << " scenes pass\n" << classes.excerpt(100) << std::endl;
+  std::cout << "reachable.csv: " << passed << " of " << rows << " scenes pass" << std::endl;
   return summary;
 }
 

@@ -1,6 +1,7 @@
 // The generator of reachable-by-construction scenes (bench_reachable.h): the base scenes of each class,
 // their variants and the keyframes taken from the variant's motion.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -69,6 +70,18 @@ nlohmann::json random_collider(Draw& d, const Vec3& c, double size) {
   }
 }
 
+// Two to four distinct particles of an n x n sheet, sorted.
+std::vector<int> random_pins(Draw& d, int n) {
+  std::vector<int> pins;
+  const int count = d.integer(2, 4);
+  while (int(pins.size()) < count) {
+    const int p = d.integer(0, n * n - 1);
+    if (std::find(pins.begin(), pins.end(), p) == pins.end()) pins.push_back(p);
+  }
+  std::sort(pins.begin(), pins.end());
+  return pins;
+}
+
 // The sheet of a cloth class (its pins, colliders, start and controls).
 nlohmann::json cloth_block(const std::string& kind, Draw& d, int index, bool reduced, ReachableScene& r) {
   const int n = reduced ? 8 : 8 + int(24 * std::pow(d.uniform(0, 1), 2));
@@ -97,14 +110,7 @@ nlohmann::json cloth_block(const std::string& kind, Draw& d, int index, bool red
     c["pins"] = "top_edge";
   } else if (kind == "hang-points") {
     horizontal();
-    std::vector<int> pins;
-    const int count = d.integer(2, 4);
-    while (int(pins.size()) < count) {
-      const int p = d.integer(0, n * n - 1);
-      if (std::find(pins.begin(), pins.end(), p) == pins.end()) pins.push_back(p);
-    }
-    std::sort(pins.begin(), pins.end());
-    c["pins"] = pins;
+    c["pins"] = random_pins(d, n);
   } else if (kind == "drop-collider") {
     horizontal();
     colliders.push_back(random_collider(d, centre, size));
@@ -268,20 +274,14 @@ std::vector<std::pair<std::string, std::string>> reachable_suite(const Reachable
   return suite;
 }
 
-ReachableScene generate_reachable(const std::string& kind, unsigned seed, int index, bool reduced,
-                                  const std::filesystem::path& directory) {
-  if (std::find(reachable_classes().begin(), reachable_classes().end(), kind) == reachable_classes().end())
-    throw std::invalid_argument("no reachable class " + kind);
-  ReachableScene r;
-  r.kind = kind;
-  r.name = kind + "-" + std::to_string(index);
-  std::uint64_t h = seed * 0x100000001b3ull + std::uint64_t(index) * 7919;
-  for (char ch : kind) h = (h ^ std::uint64_t(ch)) * 0x100000001b3ull;
-  Draw d(h);
+namespace {
+
+// The base scene of class `kind` and its variant (no keyframes yet).
+void draw_scene(const std::string& kind, Draw& d, int index, bool reduced, const std::filesystem::path& directory,
+                ReachableScene& r) {
   nlohmann::json& s = r.scene;
   s["seed"] = d.integer(1, 1000000);
-  const bool flock = kind.rfind("flock", 0) == 0;
-  if (flock) {
+  if (kind.rfind("flock", 0) == 0) {
     const int agents = reduced ? 16 : d.integer(20, 100);
     const double a = d.uniform(0, 2 * M_PI), speed = d.uniform(0, 1.5);
     s["time"] = {{"fps", 15}, {"substeps", 2}, {"frames", reduced ? 15 : d.integer(20, 45)}};
@@ -308,71 +308,92 @@ ReachableScene generate_reachable(const std::string& kind, unsigned seed, int in
       r.variant.dg = d.uniform(1.0, 3.0) * d.direction();
     }
   }
-  const Scene base = parse_base(s, directory / (r.name + ".json"));
-  const int frames = base.time.frames, p = base.particles();
-  r.keyframes = std::array<int, 4>{1, 2, 1, 3}[index % 4];
-  const std::vector<int> when = keyframe_frames(d, r.keyframes, frames);
+}
+
+// The keyframes of one frame's variant positions, and the uncontrolled miss in tolerances.
+struct Taken {
+  nlohmann::json objectives = nlohmann::json::array();
+  double worst = 0;
+};
+
+// A flock's keyframe at frame f: the hull of the variant's agents grown by a metre, or their centre of mass.
+void flock_keyframe(const std::string& kind, int f, int p, const VecX& moved, const VecX& still, Taken& t) {
+  if (kind == "flock-shape") {
+    std::vector<Vec2> pts;
+    Vec2 mean = Vec2::Zero();
+    for (int i = 0; i < p; ++i) pts.push_back(Vec2(moved(3 * i), moved(3 * i + 2))), mean += pts.back() / p;
+    nlohmann::json poly = nlohmann::json::array();
+    for (const Vec2& q : hull(pts)) {
+      const Vec2 out = q + 1.0 * (q - mean).normalized();  // a metre of margin around the agents
+      poly.push_back({out.x(), out.y()});
+    }
+    t.objectives.push_back({{"type", "shape"}, {"frame", f}, {"polygon", poly}});
+    int outside = 0;  // the uncontrolled agents outside the hull (roughly: farther than its radius)
+    double radius = 0;
+    for (const Vec2& q : pts) radius = std::max(radius, (q - mean).norm());
+    for (int i = 0; i < p; ++i) outside += (Vec2(still(3 * i), still(3 * i + 2)) - mean).norm() > radius + 1.0;
+    t.worst = std::max(t.worst, 20.0 * outside / p);
+    return;
+  }
+  Vec3 c = Vec3::Zero(), c0 = Vec3::Zero();
+  for (int i = 0; i < p; ++i) c += at(moved, i) / p, c0 += at(still, i) / p;
+  t.objectives.push_back({{"type", "center_of_mass"}, {"frame", f}, {"target", vec(c)}});
+  t.worst = std::max(t.worst, (c - c0).norm() / 0.1);
+}
+
+// A sheet's keyframe at frame f: a centre of mass or positions of all particles, an edge, a corner or a few.
+void cloth_keyframe(Draw& pick, const ClothSpec& cl, int f, int p, const VecX& moved, const VecX& still, Taken& t) {
+  const std::vector<int> parts = keyframe_particles(pick, cl.nx, cl.ny, cl.pins, pick.integer(0, 3));
+  const double tol = std::max(0.01, 0.01 * std::max(cl.width, cl.height));
+  if (parts.size() != 1 && pick.chance(0.5)) {
+    Vec3 c = Vec3::Zero(), c0 = Vec3::Zero();
+    int m = 0;
+    for (int i = 0; i < p; ++i)
+      if (parts.empty() || std::binary_search(parts.begin(), parts.end(), i)) c += at(moved, i), c0 += at(still, i), ++m;
+    nlohmann::json o = {{"type", "center_of_mass"}, {"frame", f}, {"target", vec(c / m)}};
+    if (!parts.empty()) o["particles"] = parts;
+    t.objectives.push_back(o);
+    t.worst = std::max(t.worst, (c - c0).norm() / m / tol);
+    return;
+  }
+  std::vector<int> ps = parts;
+  if (ps.empty())
+    for (int i = 0; i < p; ++i)
+      if (!std::binary_search(cl.pins.begin(), cl.pins.end(), i)) ps.push_back(i);
+  nlohmann::json targets = nlohmann::json::array();
+  for (int i : ps) targets.push_back(vec(at(moved, i)));
+  t.objectives.push_back({{"type", "position"}, {"frame", f}, {"particles", ps}, {"targets", targets}});
+  t.worst = std::max(t.worst, rms(moved, still, ps, p) / tol);
+}
+
+}  // namespace
+
+ReachableScene generate_reachable(const std::string& kind, unsigned seed, int index, bool reduced,
+                                  const std::filesystem::path& directory) {
+  if (std::find(reachable_classes().begin(), reachable_classes().end(), kind) == reachable_classes().end())
+    throw std::invalid_argument("no reachable class " + kind);
+  ReachableScene r;
+  r.kind = kind;
+  r.name = kind + "-" + std::to_string(index);
+  std::uint64_t h = seed * 0x100000001b3ull + std::uint64_t(index) * 7919;
+  for (char ch : kind) h = (h ^ std::uint64_t(ch)) * 0x100000001b3ull;
+  Draw d(h);
+  draw_scene(kind, d, index, reduced, directory, r);
+  const Scene base = parse_base(r.scene, directory / (r.name + ".json"));
+  const std::vector<int> when = keyframe_frames(d, std::array<int, 4>{1, 2, 1, 3}[index % 4], base.time.frames);
   r.keyframes = int(when.size());
   // Enlarge the variant until the uncontrolled motion misses some keyframe by three tolerances.
-  const ReachableVariant none;
-  const std::vector<VecX> still = simulate_variant(base, none);
+  const std::vector<VecX> still = simulate_variant(base, ReachableVariant{});
   for (int attempt = 0;; ++attempt) {
     const std::vector<VecX> moved = simulate_variant(base, r.variant);
-    nlohmann::json objectives = nlohmann::json::array();
-    double worst = 0;
+    Taken t;
     Draw pick(h + 17);
     for (int f : when) {
-      if (flock) {
-        if (kind == "flock-shape") {
-          std::vector<Vec2> pts;
-          Vec2 mean = Vec2::Zero();
-          for (int i = 0; i < p; ++i) pts.push_back(Vec2(moved[f](3 * i), moved[f](3 * i + 2))), mean += pts.back() / p;
-          nlohmann::json poly = nlohmann::json::array();
-          for (const Vec2& q : hull(pts)) {
-            const Vec2 out = q + 1.0 * (q - mean).normalized();  // a metre of margin around the agents
-            poly.push_back({out.x(), out.y()});
-          }
-          objectives.push_back({{"type", "shape"}, {"frame", f}, {"polygon", poly}});
-          int outside = 0;  // the uncontrolled agents outside the hull (roughly: farther than its radius)
-          double radius = 0;
-          for (const Vec2& q : pts) radius = std::max(radius, (q - mean).norm());
-          for (int i = 0; i < p; ++i)
-            outside += (Vec2(still[f](3 * i), still[f](3 * i + 2)) - mean).norm() > radius + 1.0;
-          worst = std::max(worst, 20.0 * outside / p);
-        } else {
-          Vec3 c = Vec3::Zero(), c0 = Vec3::Zero();
-          for (int i = 0; i < p; ++i) c += at(moved[f], i) / p, c0 += at(still[f], i) / p;
-          objectives.push_back({{"type", "center_of_mass"}, {"frame", f}, {"target", vec(c)}});
-          worst = std::max(worst, (c - c0).norm() / 0.1);
-        }
-        continue;
-      }
-      const ClothSpec& cl = *base.cloth;
-      const std::vector<int> parts = keyframe_particles(pick, cl.nx, cl.ny, cl.pins, pick.integer(0, 3));
-      const double tol = std::max(0.01, 0.01 * std::max(cl.width, cl.height));
-      if (parts.size() != 1 && pick.chance(0.5)) {
-        Vec3 c = Vec3::Zero(), c0 = Vec3::Zero();
-        int m = 0;
-        for (int i = 0; i < p; ++i)
-          if (parts.empty() || std::binary_search(parts.begin(), parts.end(), i))
-            c += at(moved[f], i), c0 += at(still[f], i), ++m;
-        nlohmann::json o = {{"type", "center_of_mass"}, {"frame", f}, {"target", vec(c / m)}};
-        if (!parts.empty()) o["particles"] = parts;
-        objectives.push_back(o);
-        worst = std::max(worst, (c - c0).norm() / m / tol);
-      } else {
-        std::vector<int> ps = parts;
-        if (ps.empty())
-          for (int i = 0; i < p; ++i)
-            if (!std::binary_search(cl.pins.begin(), cl.pins.end(), i)) ps.push_back(i);
-        nlohmann::json targets = nlohmann::json::array();
-        for (int i : ps) targets.push_back(vec(at(moved[f], i)));
-        objectives.push_back({{"type", "position"}, {"frame", f}, {"particles", ps}, {"targets", targets}});
-        worst = std::max(worst, rms(moved[f], still[f], ps, p) / tol);
-      }
+      if (base.flock) flock_keyframe(kind, f, base.particles(), moved[f], still[f], t);
+      else cloth_keyframe(pick, *base.cloth, f, base.particles(), moved[f], still[f], t);
     }
-    s["objectives"] = objectives;
-    if (worst >= 3 || attempt == 3) break;
+    r.scene["objectives"] = t.objectives;
+    if (t.worst >= 3 || attempt == 3) break;
     r.variant.dg *= 2, r.variant.dv *= 2, r.variant.omega *= 2, r.variant.force *= 2;
   }
   return r;

@@ -260,6 +260,14 @@ std::string smooth_cause(const Sensitivity& s, const RunFacts& facts) {
                   "costs less than the force that would remove it; change: raise the keyframe's weight or lower "
                   "controls.alpha",
                   100 * effort_share);
+  if (facts.budget)  // stalled before its budget ended: nothing measured says the target is out of reach
+    return format("cause: the dynamics are smooth (the gradient grows %.2gx over the horizon) and the objective "
+                  "stopped falling (%.2gx over the last tenth of the evaluations) before its budget ended (",
+                  s.growth, 1 / std::max(facts.recent_improvement, 1e-300)) +
+           facts.status +
+           format("), with the effort %.0f %% of the objective; change: raise the keyframe's weight, give the "
+                  "controls more time (controls.from_frame) or lower controls.alpha",
+                  100 * effort_share);
   return format("cause: the dynamics are smooth (the gradient grows %.2gx over the horizon) and the "
                 "optimiser stopped (",
                 s.growth) +
@@ -286,9 +294,29 @@ std::string unstable_cause(const RunFacts& facts) {
                         "finer time steps (time.substeps)");
 }
 
+// A keyframe the run left where the uncontrolled motion had it (within 10 % of its miss) while another
+// keyframe was met: measured by the two judgements, so it comes before any guessed cause.
+std::string untouched_cause(const std::vector<KeyframeJudgement>& keyframes) {
+  const KeyframeJudgement *untouched = nullptr, *met = nullptr;
+  for (const auto& k : keyframes) {
+    if (!k.judged) continue;
+    if (k.miss_after <= 1.0 && k.miss_before > 1.0 && !met) met = &k;
+    if (k.miss_after > 1.0 && k.miss_after >= 0.9 * k.miss_before &&
+        (!untouched || k.miss_after > untouched->miss_after))
+      untouched = &k;
+  }
+  if (!untouched || !met) return {};
+  return "cause: " + untouched->name + " was left at its uncontrolled error (" + untouched->error_after + ", " +
+         untouched->error_before + " uncontrolled) while " + met->name + " was met (" + met->error_before + " → " +
+         met->error_after + "): the optimiser steered the other keyframe, not this one" +
+         (untouched->frame < met->frame ? " (an earlier keyframe, steered only through the later one's windows)" : "") +
+         "; change: raise " + untouched->name + "'s weight, or keyframe it in a scene cut at its frame first";
+}
+
+// Noise at the start explains a run that stayed near it; one whose keyframe terms fell tenfold left it.
 std::string likely_cause(const Sensitivity& s, const RunFacts& facts) {
   if (unstable_edge(facts)) return unstable_cause(facts);
-  if (s.noisy())
+  if (s.noisy() && facts.keyframe_objective_end > 0.1 * facts.keyframe_objective_start)
     return format("cause: the objective is noise at the start (it moves by %.2g of itself under perturbations "
                   "of 1e-9): the start is a bifurcation, ",
                   s.relative_noise()) +
@@ -335,7 +363,9 @@ Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensit
     return d;
   }
   d.outcome = !d.progress ? "no_progress" : d.far ? "not_reached" : "near";
-  d.line = verdict_head(d, facts) + miss_text(*worst) + budget + "; " + likely_cause(s, facts);
+  const std::string untouched = untouched_cause(keyframes);
+  d.line = verdict_head(d, facts) + miss_text(*worst) + budget + "; " +
+           (untouched.empty() ? likely_cause(s, facts) : untouched);
   return d;
 }
 

@@ -92,7 +92,6 @@ struct Driver {
       rec.terms = problem.breakdown();
       rec.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
-    if (tape && gz) tape->record({z, *gz, phi, rec.seconds, rec.diverged, rec.unstable, rec.terms});
     rec.evaluation = ++result.evaluations;
     rec.phi = phi;
     rec.grad_norm = gz ? gz->norm() : 0;
@@ -103,7 +102,12 @@ struct Driver {
       if (step > 0.5 * reach) reach *= 2;
       result.phi = phi;
       result.z = z;
-      met = reached && !replayed && reached();
+      // A replayed evaluation has no rollout to judge: the stop rule's verdict was recorded with it.
+      met = replayed ? replayed->reached : reached && reached();
+    }
+    if (tape && gz) {
+      RecordedEvaluation e{z, *gz, phi, rec.seconds, rec.diverged, rec.unstable, met, rec.terms};
+      tape->record(std::move(e));
     }
     if (on_eval) on_eval(rec);
     result.history.push_back(std::move(rec));
@@ -146,6 +150,16 @@ std::string status_name(nlopt::result r) {
 void set_stop(OptimizeResult& r, StopReason reason, std::string status) {
   r.reason = reason;
   r.status = std::move(status);
+}
+
+// NLopt may report a forced stop as a generic failure; what stopped it is known here. A stop asked for
+// during the evaluation NLopt ended on (its line search gave up, or it converged, without asking again)
+// is an interruption too: the run stops because it was told to, whatever NLopt said.
+void settle_stop(Driver& d, const std::atomic<bool>* stop) {
+  if (stop && stop->load()) d.result.interrupted = true;
+  if (d.result.interrupted) set_stop(d.result, StopReason::kInterrupted, "interrupted");
+  else if (d.result.reached) set_stop(d.result, StopReason::kKeyframesReached, kKeyframesReached);
+  else if (d.limit_reached) set_stop(d.result, StopReason::kEvaluationLimit, status_name(nlopt::MAXEVAL_REACHED));
 }
 
 }  // namespace
@@ -202,13 +216,7 @@ OptimizeResult minimize(Problem& problem, const OptimizerSpec& spec, const VecX&
       set_stop(d.result, StopReason::kLineSearchStalled,
                std::string("stopped: line search made no progress (") + e.what() + ")");
     }
-    // NLopt may report a forced stop as a generic failure; what stopped it is known here. A stop asked for
-    // during the evaluation NLopt ended on (its line search gave up, or it converged, without asking again)
-    // is an interruption too: the run stops because it was told to, whatever NLopt said.
-    if (stop && stop->load()) d.result.interrupted = true;
-    if (d.result.interrupted) set_stop(d.result, StopReason::kInterrupted, "interrupted");
-    else if (d.result.reached) set_stop(d.result, StopReason::kKeyframesReached, kKeyframesReached);
-    else if (d.limit_reached) set_stop(d.result, StopReason::kEvaluationLimit, status_name(nlopt::MAXEVAL_REACHED));
+    settle_stop(d, stop);
   }
   d.result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d.start).count();
   if (!std::isfinite(d.result.phi)) d.result.phi = problem.evaluate(d.result.z, nullptr);

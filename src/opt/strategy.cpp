@@ -45,6 +45,8 @@ std::string set_up_stage(Run& run, const StageSpec& stage) {
     r.problem->controls().initial_velocity(z, v0_before);
   r.problem = std::make_unique<Problem>(stage_scene, r.time, *r.sys);
   Problem& problem = *r.problem;
+  r.tape.begin_stage({std::uint64_t(problem.size()), problem.controls().kind(), problem.controls().first_frame(),
+                      r.time.substeps});
   r.tape.expect(std::uint64_t(problem.size()), run.all_evaluations);
   std::string memory_line;
   if (run.hooks.configure_problem)
@@ -144,7 +146,7 @@ void search_throws_first(Run& run) {
   r.sys->release_step_schedule();
   const auto t0 = std::chrono::steady_clock::now();
   const ThrowSearch found = search_throws(*r.problem, run.plan.throw_search,
-                                          refine_fitted_throw(*r.problem, run.scene, kThrowCorrections));
+                                          refine_fitted_throw(*r.problem, run.scene, kThrowCorrections), run.stop);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::ostringstream os;
   os << std::setprecision(3) << "throw search: " << found.simulated << " rigid throws simulated (speeds within "
@@ -190,6 +192,12 @@ void run_stage(Run& run, const std::vector<StageSpec>& stages, size_t s) {
   Problem& problem = *r.problem;
   if (from_controls_file) check_resumed_controls(run, problem, r.z);
   if (s == 0 && run.plan.throw_search > 0 && !from_controls_file) search_throws_first(run);
+  if (run.stop && run.stop->load()) {  // before the stage's first evaluation: no stage to record
+    r.interrupted = true;
+    r.reason = StopReason::kInterrupted;
+    r.status = "interrupted";
+    return;
+  }
   const int stage_id = stages.size() > 1 ? int(s) + 1 : 0;
   say_stage(run, stage_id);
   if (problem.checkpoint_every() == 0 && !memory_line.empty()) run.log.say(memory_line);
@@ -215,7 +223,9 @@ void run_stage(Run& run, const std::vector<StageSpec>& stages, size_t s) {
 void run_stages(Run& run, std::vector<StageSpec>& stages, size_t first) {
   for (size_t s = first;
        s < stages.size() && !run.r.interrupted && run.r.reason != StopReason::kKeyframesReached; ++s) {
+    const size_t recorded = run.r.stages.size();
     run_stage(run, stages, s);
+    if (run.r.stages.size() == recorded) break;  // stopped before the stage's first evaluation
     if (s + 1 < stages.size() && !run.fixed_budgets)
       stages[s + 1].max_evaluations += std::max(0, stages[s].max_evaluations - run.r.stages.back().evaluations);
   }
@@ -226,9 +236,12 @@ void run_stages(Run& run, std::vector<StageSpec>& stages, size_t first) {
 // single stage's result is kept when the windows end no lower.
 void windows_after_early_end(Run& run, std::vector<StageSpec>& stages) {
   StrategyResult& r = run.r;
+  if (r.stages.empty()) return;
   const StageOutcome single = r.stages.back();
   const int left = stages[0].max_evaluations - single.evaluations;
-  if (!run.plan.windows_on_early_end || stages.size() != 1 || r.interrupted || run.resuming || run.fixed_budgets ||
+  // A run resumed from its evaluations replays its stages, windows included; one continued from controls.bin
+  // has only its last stage.
+  if (!run.plan.windows_on_early_end || stages.size() != 1 || r.interrupted || run.from_controls || run.fixed_budgets ||
       !ended_early(single.reason) || left < std::max(10, stages[0].max_evaluations / 10))
     return;
   const VecX best = r.z;

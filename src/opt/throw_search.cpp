@@ -26,7 +26,7 @@ int automatic_throw_count(int particles, int steps) {
   return int(std::clamp(4e6 / per_throw, 32.0, 512.0));
 }
 
-ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted) {
+ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted, const std::atomic<bool>* stop) {
   if (problem.controls().kind() != ControlKind::kInitialRigidVelocity)
     throw std::logic_error("search_throws: the problem's controls are not a rigid throw");
   VecX x0, v0;
@@ -62,7 +62,7 @@ ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted
     const VecX centre_z = s.z;
     const double shrink = round == 0 ? 1.0 : std::ldexp(1.0, -round);
     const int n = count / kRounds + (round < count % kRounds);
-    for (int k = 1; k <= n; ++k) {
+    for (int k = 1; k <= n && !(stop && stop->load()); ++k) {
       for (int d = 0; d < 6; ++d) {
         const double half = shrink * (d < 3 ? s.speed : s.spin);
         z[d] = centre_z[d] + (d < 3 || round > 0 ? (2 * radical_inverse(k, kPrimes[d]) - 1) * half : 0.0);

@@ -5,6 +5,8 @@
 // evenly over a box around the scene's own (a Halton sequence: the same throws on every run), forward only,
 // and the rigid stage starts from the best of them, the scene's throw and the throw fitted to the keyframes
 // (opt/throw_fit.h); the boxes after the first are centred on the best so far.
+#include <atomic>
+
 #include "core/types.h"
 #include "opt/problem.h"
 #include "opt/throw_fit.h"
@@ -28,6 +30,8 @@ int automatic_throw_count(int particles, int steps);
 // `problem` must have initial_rigid_velocity controls. The box: Δv within ±max(1 m/s, half the scene's mean
 // initial speed) on each axis, ω within ± that over the sheet's RMS radius (rim speeds alike).
 // `fitted` (refine_fitted_throw's, already flown) competes with the others and counts among the simulated.
-ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted = {});
+// A set *stop ends the search after the throw being simulated, with the best so far.
+ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted = {},
+                          const std::atomic<bool>* stop = nullptr);
 
 }  // namespace kf

@@ -19,6 +19,10 @@
 #include "core/file_name.h"
 #include "sim/mesh_wire.h"
 
+// Present only under a sanitizer: the child clears it so that its crash is not reported as the parent's
+// (a fuzzer's death callback would save the input as a finding of the parent).
+extern "C" void __sanitizer_set_death_callback(void (*)(void)) __attribute__((weak));
+
 namespace kf {
 namespace {
 
@@ -81,8 +85,10 @@ bool write_all(int fd, const std::string& bytes) {
   if (null >= 0) ::dup2(null, STDOUT_FILENO), ::dup2(null, STDERR_FILENO);
   const rlimit no_core{0, 0};
   ::setrlimit(RLIMIT_CORE, &no_core);
-  ::signal(SIGALRM, SIG_DFL);
-  ::alarm(kMeshImportSeconds);
+  // A crash ends the child by its signal, whatever handlers the parent set (a fuzzer's, a sanitizer's).
+  for (const int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGILL, SIGFPE, SIGALRM}) ::signal(sig, SIG_DFL);
+  if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(nullptr);
+  ::alarm(options.seconds);
   std::string result;
   try {
     result = import_to_bytes(name, options);
@@ -104,10 +110,10 @@ std::string read_all(int fd) {
 }
 
 // Why the child gave no scene, from how it ended.
-std::string child_failure(int status) {
+std::string child_failure(int status, unsigned seconds) {
   if (WIFSIGNALED(status)) {
     const int sig = WTERMSIG(status);
-    if (sig == SIGALRM) return "assimp did not finish reading it in " + std::to_string(kMeshImportSeconds) + " s";
+    if (sig == SIGALRM) return "assimp did not finish reading it in " + std::to_string(seconds) + " s";
     const char* what = sigabbrev_np(sig);
     return std::string("assimp crashed reading it (SIG") + (what ? what : std::to_string(sig).c_str()) + ")";
   }
@@ -135,7 +141,7 @@ std::string import_in_child(const std::string& name, const MeshImportOptions& op
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || bytes.empty())
-    throw InputError(printable(name) + ": " + child_failure(status));
+    throw InputError(printable(name) + ": " + child_failure(status, options.seconds));
   return bytes;
 }
 

@@ -20,6 +20,7 @@ struct MeshImportOptions {
   unsigned steps = 0;         // assimp post-processing flags (aiProcess_...)
   int max_bone_weights = 4;   // AI_CONFIG_PP_LBW_MAX_WEIGHTS, for aiProcess_LimitBoneWeights
   bool isolated = true;       // false: import in this process (only for measuring what isolation costs)
+  unsigned seconds = kMeshImportSeconds;  // the isolated import's time limit
 };
 
 // The scene as assimp read it (faces that are not triangles dropped; see mesh_wire.h), with its

@@ -26,8 +26,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::ofstream(file, std::ios::binary | std::ios::trunc)
       .write(reinterpret_cast<const char*>(data + 1), std::streamsize(size - 1));
   try {
-    const auto scene = kf::import_mesh_file(
-        file, {aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_LimitBoneWeights, 4});
+    // A hang of assimp ends its child after 3 s, well within the fuzzer's own timeout.
+    kf::MeshImportOptions options{aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_LimitBoneWeights, 4};
+    options.seconds = 3;
+    const auto scene = kf::import_mesh_file(file, options);
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
       const aiMesh& mesh = *scene->mMeshes[m];
       for (unsigned f = 0; f < mesh.mNumFaces; ++f)

@@ -38,10 +38,13 @@ class WrongGradientToy final : public test::ToySystem {
 struct ToyLog final : StrategyLog {
   std::vector<std::string> lines;
   std::vector<int> stage_of_evaluation, substeps_of_evaluation, budgets;
+  std::atomic<bool>* stop = nullptr;  // set after `stop_after` evaluations, as a signal would
+  size_t stop_after = 0;
   void say(const std::string& line) override { lines.push_back(line); }
   void evaluation(int stage_id, int substeps, double, const EvaluationRecord&) override {
     stage_of_evaluation.push_back(stage_id);
     substeps_of_evaluation.push_back(substeps);
+    if (stop && stage_of_evaluation.size() == stop_after) *stop = true;
   }
   void stage_started(int max_evaluations) override { budgets.push_back(max_evaluations); }
   int said(const std::string& start) const {
@@ -57,7 +60,7 @@ struct ToyRun {
 };
 
 ToyRun run_toy(const Scene& scene, const StagePlan& plan, bool wrong_gradient = false,
-               std::function<bool(Problem&)> met = {}, const std::atomic<bool>* stop = nullptr) {
+               std::function<bool(Problem&)> met = {}, std::atomic<bool>* stop = nullptr, size_t stop_after = 0) {
   const auto make = [wrong_gradient](double h) -> std::unique_ptr<System> {
     if (wrong_gradient) return std::make_unique<WrongGradientToy>(4, h);
     return std::make_unique<test::ToySystem>(4, h);
@@ -72,6 +75,8 @@ ToyRun run_toy(const Scene& scene, const StagePlan& plan, bool wrong_gradient = 
   setup.start_time = scene.time;
   setup.stop = stop;
   ToyRun run;
+  run.log.stop = stop;
+  run.log.stop_after = stop_after;
   run.result = run_strategy(std::move(setup), hooks, run.log);
   return run;
 }
@@ -107,8 +112,8 @@ TEST(StrategyRun, StagesRunInOrderAndPassTheirUnspentEvaluationsOn) {
   EXPECT_EQ(run.log.substeps_of_evaluation, expected_substeps);
   EXPECT_EQ(r.time.substeps, 2);
   EXPECT_EQ(r.evaluations, r.stages[0].evaluations + r.stages[1].evaluations + r.stages[2].evaluations);
-  // Each stage starts from the controls the last one found: no later stage starts higher than it ended.
-  EXPECT_LE(r.stages[1].objective_start, r.stages[0].objective_end * (1 + 1e-6));
+  // Each stage starts from the controls the last one found: at the same substeps, where the last one ended.
+  EXPECT_DOUBLE_EQ(r.stages[2].objective_start, r.stages[1].objective_end);
   EXPECT_LT(r.stages[0].objective_end, r.stages[0].objective_start);
   EXPECT_EQ(r.tape.records().size(), size_t(r.evaluations));
 }
@@ -180,11 +185,23 @@ TEST(StrategyRun, WithoutStopWhenReachedTheRuleIsNotAsked) {
 
 TEST(StrategyRun, AStopRequestEndsTheRunInItsStage) {
   const Scene scene = toy_scene(R"({"split_schedule": "adaptive"})");
-  const std::atomic<bool> stop{true};
-  const ToyRun run = run_toy(scene, plan_of({{2, 30, std::nullopt}, {2, 30, std::nullopt}}), false, {}, &stop);
+  std::atomic<bool> stop{false};
+  const ToyRun run = run_toy(scene, plan_of({{2, 30, std::nullopt}, {2, 30, std::nullopt}}), false, {}, &stop, 4);
   ASSERT_EQ(run.result.stages.size(), 1u);
   EXPECT_TRUE(run.result.interrupted);
   EXPECT_EQ(run.result.reason, StopReason::kInterrupted);
+  EXPECT_EQ(run.result.evaluations, 4);  // the evaluation asked for after the request is not made
+}
+
+TEST(StrategyRun, AStopRequestBeforeTheFirstEvaluationRecordsNoStage) {
+  const Scene scene = toy_scene(R"({"split_schedule": "adaptive"})");
+  std::atomic<bool> stop{true};
+  const ToyRun run = run_toy(scene, plan_of({{2, 30, std::nullopt}, {2, 30, std::nullopt}}), false, {}, &stop);
+  EXPECT_TRUE(run.result.stages.empty());
+  EXPECT_TRUE(run.result.interrupted);
+  EXPECT_EQ(run.result.reason, StopReason::kInterrupted);
+  EXPECT_EQ(run.result.evaluations, 0);
+  EXPECT_TRUE(run.log.stage_of_evaluation.empty());
 }
 
 TEST(StrategyRun, ASingleStageThatEndedEarlyIsFollowedByWindows) {
@@ -200,11 +217,11 @@ TEST(StrategyRun, ASingleStageThatEndedEarlyIsFollowedByWindows) {
   EXPECT_EQ(run.log.said("the one stage ended (converged"), 1);
   const std::vector<StageSpec> windows = window_stages(scene, 200 - r.stages[0].evaluations);
   EXPECT_EQ(r.planned_stages, 1 + int(windows.size()));
-  // The windows start from no force over the shortest window.
+  // The windows start from no force over the shortest window, on the lattice.
   EXPECT_EQ(run.log.said("optimising strategy_run stage 2"), 1);
   ASSERT_EQ(run.log.said("optimising strategy_run stage 2: toy chain"), 1);
   for (const auto& line : run.log.lines)
-    if (line.rfind("optimising strategy_run stage 2", 0) == 0) EXPECT_NE(line.find("(per_frame from frame 23)"), std::string::npos) << line;
+    if (line.rfind("optimising strategy_run stage 2", 0) == 0) EXPECT_NE(line.find("(per_frame_lattice from frame 23)"), std::string::npos) << line;
   // The result is the better of the single stage and the windows.
   const bool windows_kept = r.stages.back().objective_end < r.stages[0].objective_end;
   EXPECT_EQ(run.log.said("the windows ended no lower"), windows_kept ? 0 : 1);

@@ -17,9 +17,10 @@ namespace kf {
 namespace {
 
 Scene strategy_scene(const std::string& body, const std::string& controls, const std::string& optimizer = "{}") {
+  const std::string y = body.find("\"flock\"") != std::string::npos ? "0" : "0.1";  // a flock's targets are on the ground
   return parse_scene(R"({"time": {"fps": 30, "substeps": 2, "frames": 30}, )" + body + R"(,
-    "objectives": [{"type": "center_of_mass", "frame": 28, "target": [0.3, 0.1, 0.2], "weight": 1e8},
-                   {"type": "center_of_mass", "frame": 12, "target": [0.1, 0.1, 0.1]}],
+    "objectives": [{"type": "center_of_mass", "frame": 28, "target": [0.3, )" + y + R"(, 0.2], "weight": 1e8},
+                   {"type": "center_of_mass", "frame": 12, "target": [0.1, )" + y + R"(, 0.1]}],
     "controls": )" + controls + R"(, "optimizer": )" + optimizer + "}",
                      "strategy.json");
 }

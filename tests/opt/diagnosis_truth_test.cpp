@@ -1,0 +1,108 @@
+// Diagnoses that say only what the run measured: a keyframe left at its uncontrolled error while another was
+// met is named as such; noise at the start is blamed only when the run stayed near it (its keyframe terms fell
+// less than tenfold); a run that
+// stalled before its budget ended is not called out of reach. On a generated scene whose keyframes are
+// reachable by construction (bench/bench_reachable.h), the failure names the keyframe left behind.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "app/optimize_job.h"
+#include "bench/bench_reachable.h"
+#include "opt/diagnosis.h"
+#include "../sim/character_test_util.h"
+
+namespace kf {
+namespace {
+
+KeyframeJudgement judged(const std::string& name, int frame, double before, double after, const std::string& eb,
+                         const std::string& ea) {
+  KeyframeJudgement k;
+  k.name = name;
+  k.frame = frame;
+  k.judged = true;
+  k.miss_before = before;
+  k.miss_after = after;
+  k.error_before = eb;
+  k.error_after = ea;
+  k.tolerance = "1.00 cm";
+  return k;
+}
+
+RunFacts run(double start, double end, const std::string& status) {
+  RunFacts f;
+  f.status = status;
+  f.budget = status.find("limit reached") != std::string::npos;
+  f.keyframe_objective_start = f.objective_start = f.max_objective = start;
+  f.keyframe_objective_end = end;
+  f.evaluations = 300;
+  return f;
+}
+
+Sensitivity noisy_start() {
+  Sensitivity s;
+  s.phi = 15;
+  s.phi_noise = 1.8;  // relative noise 0.12
+  return s;
+}
+
+TEST(DiagnosisTruth, AKeyframeLeftAtItsUncontrolledErrorWhileAnotherWasMetIsNamed) {
+  const std::vector<KeyframeJudgement> k = {judged("center_of_mass@7", 7, 1.87, 1.86, "1.87 cm", "1.86 cm"),
+                                            judged("position@15", 15, 9.0, 0.4, "9.00 cm", "0.40 cm")};
+  for (const Sensitivity& s : {Sensitivity{}, noisy_start()}) {
+    const std::string line = diagnose(k, s, run(10, 0.2, "converged")).line;
+    EXPECT_NE(line.find("center_of_mass@7 was left at its uncontrolled error (1.86 cm, 1.87 cm uncontrolled) while "
+                        "position@15 was met"),
+              std::string::npos)
+        << line;
+    EXPECT_NE(line.find("an earlier keyframe"), std::string::npos) << line;
+    EXPECT_EQ(line.find("noise at the start"), std::string::npos) << line;
+    EXPECT_EQ(line.find("out of reach"), std::string::npos) << line;
+  }
+  // Both keyframes moved: not named so.
+  const std::vector<KeyframeJudgement> moved = {judged("center_of_mass@7", 7, 9.0, 2.0, "9 cm", "2 cm"),
+                                                judged("position@15", 15, 9.0, 0.4, "9 cm", "0.4 cm")};
+  EXPECT_EQ(diagnose(moved, Sensitivity{}, run(10, 0.2, "converged")).line.find("uncontrolled error"),
+            std::string::npos);
+}
+
+TEST(DiagnosisTruth, NoiseAtTheStartOnlyForARunThatNeverLeftIt) {
+  const std::vector<KeyframeJudgement> k = {judged("position@15", 15, 9.0, 2.0, "9 cm", "2 cm")};
+  EXPECT_NE(diagnose(k, noisy_start(), run(10, 9, "converged")).line.find("noise at the start"), std::string::npos);
+  EXPECT_NE(diagnose(k, noisy_start(), run(10, 4, "converged")).line.find("noise at the start"), std::string::npos);
+  const std::string line = diagnose(k, noisy_start(), run(10, 0.5, "converged")).line;  // fell 20x: left it
+  EXPECT_EQ(line.find("noise at the start"), std::string::npos) << line;
+}
+
+TEST(DiagnosisTruth, AStallBeforeTheBudgetEndedIsNotCalledOutOfReach) {
+  const std::vector<KeyframeJudgement> k = {judged("position@15", 15, 9.0, 2.0, "9 cm", "2 cm")};
+  RunFacts f = run(10, 0.5, "evaluation limit reached");
+  f.recent_improvement = 1;  // stalled: not the budget's fault
+  const std::string line = diagnose(k, Sensitivity{}, f).line;
+  EXPECT_EQ(line.find("out of reach"), std::string::npos) << line;
+  EXPECT_NE(line.find("stopped falling"), std::string::npos) << line;
+  EXPECT_NE(diagnose(k, Sensitivity{}, run(10, 0.5, "converged")).line.find("out of reach"), std::string::npos);
+}
+
+// The reduced generated drop onto a collider (two keyframes): the early centre of mass is left where the
+// uncontrolled drop has it while the late keyframe is met, and the diagnosis says so.
+TEST(DiagnosisTruth, GeneratedDropNamesTheEarlyKeyframeLeftBehind) {
+  test::TempDir dir;
+  const ReachableScene r = generate_reachable("drop-collider", 52, 1, true, dir.path());
+  std::ofstream(dir.path() / "scene.json") << r.scene.dump(1);
+  OptimizeOptions opt;
+  opt.quiet = true;
+  opt.out = (dir.path() / "run").string();
+  const OptimizeOutcome outcome = optimize_job(dir.path() / "scene.json", opt);
+  std::ifstream in(dir.path() / "run" / "report.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  if (!outcome.failed) GTEST_SKIP() << "met its keyframes: " << outcome.diagnosis;
+  EXPECT_EQ(outcome.diagnosis.find("out of reach"), std::string::npos) << outcome.diagnosis;
+  EXPECT_EQ(outcome.diagnosis.find("noise at the start"), std::string::npos) << outcome.diagnosis;
+  EXPECT_NE(outcome.diagnosis.find("was left at its uncontrolled error"), std::string::npos) << outcome.diagnosis;
+}
+
+}  // namespace
+}  // namespace kf

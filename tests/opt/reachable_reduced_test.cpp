@@ -1,0 +1,71 @@
+// Reduced versions of the reachable-by-construction suite (`keyframe bench --only reachable`): one generated
+// scene of each class, made small (an 8 x 8 sheet or 16 agents, at most 20 frames), optimised through
+// `keyframe optimize`'s job at its default settings and judged by the suite's criterion (every keyframe
+// within its tolerance, opt/diagnosis.h).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "app/optimize_job.h"
+#include "bench/bench_reachable.h"
+#include "../sim/character_test_util.h"
+
+namespace kf {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Scene 1 of each class (two keyframes where the class has them); scene 0 (one keyframe) of the drop onto a
+// collider, whose scene 1 leaves its early keyframe behind (DiagnosisTruth.GeneratedDrop...), and of the
+// blanket on Testwuson.X, whose scene 1 ends its budget short of its keyframes (REPORT, known limitations).
+int scene_index(const std::string& kind) { return kind == "drop-collider" || kind == "cape-wuson" ? 0 : 1; }
+
+void expect_reduced_scene_meets_its_keyframes(const std::string& kind) {
+  test::TempDir dir;
+  const ReachableScene r = generate_reachable(kind, 52, scene_index(kind), true, dir.path());
+  std::ofstream(dir.path() / "scene.json") << r.scene.dump(1);
+  OptimizeOptions opt;
+  opt.quiet = true;
+  opt.out = (dir.path() / "run").string();
+  const OptimizeOutcome outcome = optimize_job(dir.path() / "scene.json", opt);
+  EXPECT_FALSE(outcome.failed) << outcome.diagnosis;
+  std::ifstream in(dir.path() / "run" / "report.json");
+  const json report = json::parse(in);
+  ASSERT_EQ(report.at("keyframe_errors").size(), std::size_t(r.keyframes));
+  bool missed_before = false;
+  for (const json& k : report.at("keyframe_errors")) {
+    EXPECT_TRUE(k.at("met").get<bool>()) << k.dump();
+    missed_before |= k.at("miss_before").get<double>() > 1.0;
+  }
+  EXPECT_TRUE(missed_before) << "every keyframe met without optimising";
+}
+
+// The classes without and with a character (Embree's queries run untrapped: tests/test_main.cpp).
+std::vector<std::string> classes(bool character) {
+  std::vector<std::string> v;
+  for (const std::string& c : reachable_classes())
+    if ((c.rfind("cape", 0) == 0) == character) v.push_back(c);
+  return v;
+}
+
+std::string test_name(const testing::TestParamInfo<std::string>& info) {
+  std::string s = info.param;
+  for (char& c : s)
+    if (c == '-') c = '_';
+  return s;
+}
+
+class ReachableReduced : public testing::TestWithParam<std::string> {};
+class ReachableCapeReduced : public testing::TestWithParam<std::string> {};
+
+TEST_P(ReachableReduced, MeetsEveryKeyframeAtDefaults) { expect_reduced_scene_meets_its_keyframes(GetParam()); }
+TEST_P(ReachableCapeReduced, MeetsEveryKeyframeAtDefaults) { expect_reduced_scene_meets_its_keyframes(GetParam()); }
+
+INSTANTIATE_TEST_SUITE_P(Generated, ReachableReduced, testing::ValuesIn(classes(false)), test_name);
+INSTANTIATE_TEST_SUITE_P(Generated, ReachableCapeReduced, testing::ValuesIn(classes(true)), test_name);
+
+}  // namespace
+}  // namespace kf
