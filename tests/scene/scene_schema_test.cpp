@@ -154,7 +154,7 @@ TEST_F(SceneSchema, KeysCarryTheParsersTypesBoundsAndChoices) {
             Json::parse(R"(["position", "velocity", "center_of_mass", "shape", "arch"])"));
   EXPECT_EQ(objective["properties"]["frame"], Json::parse(R"({"type": "integer", "minimum": 0})"));
   EXPECT_FALSE(objective["properties"]["particles"]["items"].contains("maximum"));
-  EXPECT_EQ(props["cloth"]["properties"]["pins"]["anyOf"].size(), 3u);  // a named set, indices, or an object
+  EXPECT_EQ(props["cloth"]["properties"]["pins"]["anyOf"].size(), 3u);  // indices, a named set, a selector or box
   EXPECT_EQ(props["cloth"]["properties"]["colliders"]["items"]["required"], Json::parse(R"(["type"])"));
   EXPECT_FALSE(props["character"].contains("required") &&
                std::find(props["character"]["required"].begin(), props["character"]["required"].end(), "time") !=
