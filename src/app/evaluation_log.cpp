@@ -46,8 +46,11 @@ void write_history_csv(const std::filesystem::path& path, const std::vector<Hist
   int k = 0;
   for (const auto& r : rows) {
     os << ++k << "," << r.seconds << "," << r.rec.phi << "," << r.rec.grad_norm << "," << r.stage << "," << r.substeps;
-    for (size_t i = 0; i < names.size(); ++i)
-      os << "," << (i < r.rec.terms.size() && !r.rec.diverged ? r.rec.terms[i].second : NAN);
+    // A diverged evaluation has no terms (and no output holds a non-finite value): its cells stay empty.
+    for (size_t i = 0; i < names.size(); ++i) {
+      os << ",";
+      if (i < r.rec.terms.size() && !r.rec.diverged && std::isfinite(r.rec.terms[i].second)) os << r.rec.terms[i].second;
+    }
     os << "\n";
   }
   write_file_atomic(path, os.str());

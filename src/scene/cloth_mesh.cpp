@@ -61,6 +61,29 @@ ClothMesh compacted(const std::string& file, const std::vector<Vec3>& all, std::
   return m;
 }
 
+// The corners of an OBJ face line after "f", as 0-based vertex indices (a, a/t, a//n, a/t/n; negative: from
+// the end of the `vertices` read so far).
+template <class Fail>
+std::vector<int> read_face_corners(std::istringstream& ls, long vertices, const Fail& fail) {
+  std::vector<int> f;
+  std::string corner;
+  while (ls >> corner) {
+    long i = 0;
+    try {
+      size_t used = 0;
+      i = std::stol(corner, &used);
+      if (used < corner.size() && corner[used] != '/') fail("bad face corner \"" + corner + "\"");
+    } catch (const std::logic_error&) {
+      fail("bad face corner \"" + corner + "\"");
+    }
+    if (i < 0) i += vertices + 1;
+    if (i < 1 || i > vertices) fail("face corner " + corner + " names no vertex read so far");
+    if (f.size() >= size_t(kMaxCorners)) fail("a face with more than " + std::to_string(kMaxCorners) + " corners");
+    f.push_back(int(i - 1));
+  }
+  return f;
+}
+
 // OBJ: "v x y z", "f a b c ..." (a, a/t, a//n, a/t/n; negative: from the end), "o"/"g" names.
 ClothMesh read_obj(const std::filesystem::path& path, const std::string& name) {
   const std::string file = path.string();
@@ -97,23 +120,7 @@ ClothMesh read_obj(const std::filesystem::path& path, const std::string& name) {
     } else if (tag == "f") {
       const bool wanted = name.empty() || object == name || group == name;
       named_found = named_found || wanted;
-      std::vector<int> f;
-      std::string corner;
-      while (ls >> corner) {
-        long i = 0;
-        try {
-          size_t used = 0;
-          i = std::stol(corner, &used);
-          if (used < corner.size() && corner[used] != '/') fail("bad face corner \"" + corner + "\"");
-        } catch (const std::logic_error&) {
-          fail("bad face corner \"" + corner + "\"");
-        }
-        const long n = long(vertices.size());
-        if (i < 0) i += n + 1;
-        if (i < 1 || i > n) fail("face corner " + corner + " names no vertex read so far");
-        if (f.size() >= size_t(kMaxCorners)) fail("a face with more than " + std::to_string(kMaxCorners) + " corners");
-        f.push_back(int(i - 1));
-      }
+      std::vector<int> f = read_face_corners(ls, long(vertices.size()), fail);
       if (f.size() < 3) fail("expected a face of at least 3 corners");
       if (wanted) add_face(std::move(f), faces);
     }

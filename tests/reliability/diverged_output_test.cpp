@@ -1,6 +1,6 @@
 // Runs whose simulation diverges, through the real `keyframe` binary: a flock trial that blows up counts as
 // diverged (a large finite objective, exit 7 with the reason) and leaves no non-finite value in
-// trajectory.bin, controls.bin or report.json; `gradcheck` at diverging controls says so instead of
+// trajectory.bin, controls.bin, report.json or iterations.csv; `gradcheck` at diverging controls says so instead of
 // reporting an error of 0; and `gradcheck --at` refuses a controls.bin that is not a regular file.
 #include <sys/stat.h>
 
@@ -50,6 +50,9 @@ class DivergedOutput : public TempDirTest {
     const std::string report = read_text(dir_ / "run/report.json");
     EXPECT_TRUE(json_all_finite(nlohmann::json::parse(report)));
     EXPECT_EQ(report.find("NaN"), std::string::npos);
+    // A diverged evaluation has no terms: its cells are empty, never nan or inf.
+    const std::string history = read_text(dir_ / "run/iterations.csv");
+    for (const char* bad : {"nan", "inf", "NaN", "Inf"}) EXPECT_EQ(history.find(bad), std::string::npos) << history;
   }
 };
 

@@ -152,14 +152,15 @@ TEST_F(RunDirTrust, DeeplyNestedSceneIsRefusedWithoutCrashing) {
 TEST_F(RunDirTrust, FailedOptimizeLeavesTheExistingRunUnchanged) {
   write("f.json", small_flock_scene(6));
   ASSERT_TRUE(wrote_run(run_keyframe("optimize f.json --quiet --out run", dir_).code));
-  // Accepted by the scene reader, refused once the objective is built (after the old code had replaced
-  // scene.json): a coverage spacing that gives 10^8 samples.
+  // A coverage spacing that gives 10^8 samples, refused with the scene (an older reader refused it only
+  // once the objective was built, after it had replaced scene.json).
   write("bad.json", R"({"time": {"frames": 6}, "flock": {"agents": 12, "spawn": {"radius": 3}},
     "objectives": [{"type": "shape", "frame": 6, "polygon": [[-5, -5], [5, -5], [5, 5], [-5, 5]],
                     "coverage": {"weight": 1, "spacing": 0.001}}],
     "optimizer": {"max_evaluations": 2}})");
   expect_refused_unchanged("optimize bad.json --quiet --out run", kExitInput,
-                           "shape keyframe: coverage spacing 0.001000 m gives more than 100,000 samples");
+                           "bad.json: /objectives/0/coverage/spacing: the coverage grid over the shape's "
+                           "bounding box would have 1e+08 samples (at most 100,000): raise \"spacing\"");
   // The run still renders and resumes as itself.
   EXPECT_EQ(run_keyframe("render run", dir_).code, 0);
   EXPECT_TRUE(fs::exists(dir_ / "run/frames/frame_0006.png"));
