@@ -23,15 +23,25 @@ struct CliResult {
   std::string output;  // stdout and stderr together
 };
 
-// Runs `keyframe ARGS` in `cwd` through the shell (ARGS is pasted verbatim).
-inline CliResult run_keyframe(const std::string& args, const fs::path& cwd) {
-  const std::string cmd = "cd '" + cwd.string() + "' && '" KEYFRAME_BINARY "' " + args + " 2>&1";
+// Runs `COMMAND 2>&1` in `cwd` through the shell and collects what it prints.
+inline CliResult run_in(const std::string& command, const fs::path& cwd) {
+  const std::string cmd = "cd '" + cwd.string() + "' && " + command + " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   std::string out;
   std::array<char, 4096> buf;
   while (size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
   const int status = pclose(p);
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+// Runs `keyframe ARGS` in `cwd` through the shell (ARGS is pasted verbatim).
+inline CliResult run_keyframe(const std::string& args, const fs::path& cwd) {
+  return run_in("'" KEYFRAME_BINARY "' " + args, cwd);
+}
+
+// The same, killed after a minute, so that a hang fails the test instead of stalling it.
+inline CliResult run_bounded(const std::string& args, const fs::path& cwd) {
+  return run_in("timeout -s KILL 60 '" KEYFRAME_BINARY "' " + args, cwd);
 }
 
 // Every path under `dir`, relative and sorted; directories end in '/'.

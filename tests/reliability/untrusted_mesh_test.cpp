@@ -10,17 +10,6 @@ namespace {
 
 const fs::path kModels = "/usr/share/assimp/models";  // Debian's assimp-testmodels
 
-// `keyframe ARGS` in `cwd`, killed after a minute so that a hang fails the test instead of stalling it.
-CliResult run_bounded(const std::string& args, const fs::path& cwd) {
-  const std::string cmd = "cd '" + cwd.string() + "' && timeout -s KILL 60 '" KEYFRAME_BINARY "' " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
-  const int status = pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
-
 int lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
 
 // A cloth scene whose character is `file` (the anchors are looked for only after it is read).

@@ -8,16 +8,6 @@
 namespace kf::reliability {
 namespace {
 
-CliResult run_bounded(const std::string& args, const fs::path& cwd) {
-  const std::string cmd = "cd '" + cwd.string() + "' && timeout -s KILL 60 '" KEYFRAME_BINARY "' " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
-  const int status = pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
-
 std::string flock_scene(const std::string& shape, int agents = 10) {
   return R"({"time": {"frames": 10}, "flock": {"agents": )" + std::to_string(agents) +
          R"(, "spawn": {"radius": 4}}, "objectives": [{"type": "shape", "frame": 10, )" + shape +
