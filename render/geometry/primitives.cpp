@@ -1,5 +1,6 @@
 #include "render/geometry/primitives.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -132,6 +133,34 @@ void add_capsule(Mesh& m, const Vec3& a, const Vec3& b, double r, const Vec3& co
     n = std::cos(theta) * e + std::sin(theta) * (std::cos(u) * e1 + std::sin(u) * e2);
     p = (at_b ? b : a) + r * n;
   });
+}
+
+void add_rounded_box(Mesh& m, const Vec3& c, const Mat3& axes, const Vec3& half, double r, const Vec3& color) {
+  const auto corner = [&](const Vec3& s) { return Vec3(c + axes * half.cwiseProduct(s)); };
+  for (int k = 0; k < 3; ++k) {
+    const int a = (k + 1) % 3, b = (k + 2) % 3;
+    for (const double side : {-1.0, 1.0}) {
+      // The face across axis k on `side`: its outward normal and its corners, counter-clockwise from outside.
+      const Vec3 n = side * axes.col(k), mid = c + axes.col(k) * (side * (half[k] + r));
+      const Vec3 ua = axes.col(a) * half[a], ub = axes.col(b) * half[b];
+      if (side > 0) add_flat_quad(m, mid - ua - ub, mid + ua - ub, mid + ua + ub, mid - ua + ub, n, color);
+      else add_flat_quad(m, mid - ua - ub, mid - ua + ub, mid + ua + ub, mid + ua - ub, n, color);
+      // The edges along axis k (four of them, each met twice over the loop over sides: draw at side > 0).
+      if (r <= 0 || side < 0) continue;
+      for (const double sa : {-1.0, 1.0})
+        for (const double sb : {-1.0, 1.0}) {
+          Vec3 s0 = Vec3::Zero();
+          s0[a] = sa;
+          s0[b] = sb;
+          Vec3 s1 = s0;
+          s0[k] = -1;
+          s1[k] = 1;
+          const Vec3 p0 = corner(s0), p1 = corner(s1);
+          if ((p1 - p0).norm() > 1e-9 * std::max(r, 1.0)) add_capsule(m, p0, p1, r, color);
+          else add_sphere(m, p0, r, color);
+        }
+    }
+  }
 }
 
 // Small octahedron: a target point in space.

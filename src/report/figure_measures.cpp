@@ -247,6 +247,8 @@ nlohmann::json collider_measures(const ClothSpec& cloth, const ColliderSpec& c, 
                         },
                         [](const SphereShape&) { return nlohmann::json(); },
                         [](const CapsuleShape&) { return nlohmann::json(); },
+                        [&](const BoxShape&) { return surface_measures(c, t); },
+                        [&](const RectangleShape&) { return surface_measures(c, t); },
                     },
                     c.shape);
 }
@@ -334,6 +336,31 @@ nlohmann::json ground_measures(const GroundShape& ground, double thickness, cons
           {"lowest_at_end", lowest},
           {"mean_height_at_end", sum / std::max(1, p)},
           {"on_ground_at_end", lowest <= 2 * thickness}};
+}
+
+nlohmann::json surface_measures(const ColliderSpec& collider, const Trajectory& t) {
+  const std::vector<std::unique_ptr<Collider>> made = make_colliders({collider}, 0.0);
+  const auto& surface = dynamic_cast<const DistanceCollider&>(*made.front());
+  double min_phi = std::numeric_limits<double>::infinity();
+  int min_frame = 0, touching = 0;
+  for (int f = 0; f < t.frames(); ++f) {
+    const VecX& x = t.x[size_t(f)];
+    for (int i = 0; i < x.size() / 3; ++i) {
+      double phi;
+      Vec3 n;
+      Mat3 dn;
+      surface.distance(seg(x, i), phi, n, dn);
+      if (phi < min_phi) {
+        min_phi = phi;
+        min_frame = f;
+      }
+      if (f + 1 == t.frames() && phi <= 2 * collider.thickness) ++touching;
+    }
+  }
+  return {{"type", type_name(collider)},
+          {"min_distance", min_phi},
+          {"min_distance_frame", min_frame},
+          {"touching_at_end", touching}};
 }
 
 namespace {

@@ -40,6 +40,10 @@ nlohmann::json cape_end_state(const Scene& scene, const Trajectory& run, const T
 // Ring measures of one torus collider over the frames of a run (the "ring" object described above).
 nlohmann::json ring_measures(const TorusShape& torus, const Trajectory& frames);
 nlohmann::json ground_measures(const GroundShape& ground, double thickness, const Trajectory& frames);
+// A box's or a rectangle's: the smallest signed distance of any particle from its surface over the frames
+// ("min_distance", m, negative: inside; "min_distance_frame") and how many particles rest on it at the end
+// (within two contact thicknesses: "touching_at_end").
+nlohmann::json surface_measures(const ColliderSpec& collider, const Trajectory& frames);
 
 // Nearest-neighbour distance of each particle in the ground plane (x, z) at one state.
 // Linear in the particles (a neighbour grid), equal to comparing all pairs.

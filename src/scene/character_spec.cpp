@@ -24,8 +24,16 @@ double animation_time(const CharacterSpec& spec, double frame) {
   return k.back().y();
 }
 
+Eigen::Affine3d character_conform(const CharacterSpec& spec) {
+  Mat3 up = Mat3::Identity();
+  if (spec.z_up) up << 1, 0, 0, 0, 0, 1, 0, -1, 0;  // (x, y, z) -> (x, z, -y)
+  Eigen::Affine3d conform = Eigen::Affine3d::Identity();
+  conform.linear() = spec.scale * up;
+  return conform;
+}
+
 Eigen::Affine3d character_placement(const CharacterSpec& spec, double frame) {
-  Eigen::Affine3d placement(Eigen::Translation3d(spec.offset));
+  const Eigen::Affine3d placement = Eigen::Translation3d(spec.offset) * character_conform(spec);
   const auto& k = spec.root.keys;
   if (k.empty()) return placement;
   Vec3 translate = k.front().translate;
@@ -42,8 +50,8 @@ Eigen::Affine3d character_placement(const CharacterSpec& spec, double frame) {
       }
   }
   const Vec3& p = spec.root.pivot;
-  return placement * Eigen::Translation3d(translate + p) * Eigen::AngleAxisd(angle * M_PI / 180.0, spec.root.axis) *
-         Eigen::Translation3d(-p);
+  return Eigen::Translation3d(spec.offset) * Eigen::Translation3d(translate + p) *
+         Eigen::AngleAxisd(angle * M_PI / 180.0, spec.root.axis) * Eigen::Translation3d(-p) * character_conform(spec);
 }
 
 namespace {
@@ -115,13 +123,27 @@ CapeAnchors load_cape_anchors(const std::filesystem::path& file) {
 
 namespace {
 
-// The cape's anchors: the "anchors" block, or the file beside the mesh.
-CapeAnchors read_cape_anchors(Block& b, const std::filesystem::path& mesh) {
-  if (auto anchors = b.optional_child("anchors")) return parse_cape_anchors(*anchors);
-  const auto file = cape_anchors_file(mesh);
-  if (!std::filesystem::exists(file))
-    b.fail("anchors", "expected an \"anchors\" block {\"nodes\"} or {\"points\"}, or the file " + file.string() +
-                          " beside the mesh");
+// The cape's anchors: the "anchors" block (its points in metres, Y up, taken to the file's frame), "none",
+// or the file beside the mesh (the asset's own, in the file's frame), or none without one.
+CapeAnchors read_cape_anchors(Block& b, const CharacterSpec& c) {
+  if (b.has("anchors") && b.json().at("anchors").is_string()) {
+    b.string("anchors", "none", {"none"});
+    CapeAnchors none;
+    none.none = true;
+    return none;
+  }
+  if (auto anchors = b.optional_child("anchors")) {
+    CapeAnchors a = parse_cape_anchors(*anchors);
+    const Eigen::Affine3d to_file = character_conform(c).inverse();
+    for (Vec3& p : a.points) p = to_file * p;
+    return a;
+  }
+  const auto file = cape_anchors_file(c.file);
+  if (std::error_code ec; !std::filesystem::exists(file, ec)) {
+    CapeAnchors none;
+    none.none = true;
+    return none;
+  }
   return load_cape_anchors(file);
 }
 
@@ -164,6 +186,9 @@ void read_end_target(Block& end, CharacterSpec& c, Scene& scene, int p) {
 
 CharacterSpec parse_character_spec(Block b, Scene& scene) {
   if (!scene.cloth) b.fail_here("expected a \"cloth\" block for the cape (a character needs a cloth)");
+  if (scene.cloth->self_stated)
+    throw InputError(b.file() + ": /cloth/self: expected no self block on a cape (its self contact is "
+                     "\"character\": {\"self\": ...})");
   CharacterSpec c;
   c.where = b.file() + ": " + b.json_pointer();
   const int p = scene.particles();
@@ -181,9 +206,12 @@ CharacterSpec parse_character_spec(Block b, Scene& scene) {
     // The animation at its own rate from its start; the character holds its last pose after its end.
     c.time_keys = {{0.0, 0.0}, {double(scene.time.frames), scene.time.frames / scene.time.fps}};
   }
+  c.scale = b.number("scale", 1.0, 1e-6, 1e6);
+  c.z_up = b.string("up_axis", "y", {"y", "z"}) == "z";
+  c.loop = b.boolean("loop", false);
   c.offset = b.vec3("offset", Vec3::Zero());
   if (auto root = b.optional_child("root")) c.root = parse_root_motion(*root);
-  c.anchors = read_cape_anchors(b, c.file);
+  c.anchors = read_cape_anchors(b, c);
   read_body_contact(b.child("body"), c);
   read_self_contact(b.child("self"), c);
   if (auto start = b.optional_child("start")) {

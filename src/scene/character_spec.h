@@ -10,16 +10,22 @@
 //                                      // linear between keys, held before the first and after the last;
 //                                      // default: the animation plays from its start at its own rate
 //                                      // (frame f at f / fps seconds) and holds its last pose after its end
-//     "offset": [0, 0, 0],             // world-from-file translation, metres
+//     "scale": 1, "up_axis": "y",      // metres per file unit (0.01: centimetres) and its up axis
+//                                      // ("z": (x, y, z) -> (x, z, -y)), applied first: anchors' points, the
+//                                      // root's pivot and the offset are in metres, Y up
+//     "loop": false,                   // a clip shorter than the scene plays again from its start
+//     "offset": [0, 0, 0],             // world translation, metres
 //     "root": {"pivot": [0, -1.024, 0], "axis": [1, 0, 0],   // a rigid motion on top of the animation:
 //              "keys": [{"frame": 0, "translate": [0, 1.2, 0], "angle": 0}, ...]}  // translation (m) and
-//                                      // rotation (degrees) about the axis through the pivot (file frame),
+//                                      // rotation (degrees) about the axis through the pivot (metres, Y up),
 //                                      // piecewise linear between keys, held outside them
 //     "anchors": {"mesh": "Torso", "points": [[-0.18, 0.47, -0.22], ...]},
 //                                      // where the cape's top edge hangs (below); or by node (bone)
 //                                      // names: {"nodes": ["L_Shoulder", "Neck", "R_Shoulder"]}
-//                                      // (`keyframe inspect MESH` lists them); default: the file
-//                                      // beside the mesh named like it with ".cape.json"
+//                                      // (`keyframe inspect MESH` lists them); "none": the cloth is
+//                                      // not pinned to the body (its own "pins" hold); default: the
+//                                      // file beside the mesh named like it with ".cape.json" (in the
+//                                      // file's own units and axes), or "none" without one
 //     "body": {"thickness": 0.012, "stiffness": 2000, "search": 0.06,
 //              "friction": 0, "friction_velocity": 0.01},  // Coulomb coefficient, sticking speed (m/s)
 //     "self": {"enabled": true, "thickness": 0.01, "stiffness": 500, "friction": 0, "friction_velocity": 0.01},
@@ -27,7 +33,9 @@
 //     "end_target": {"run": "../out/cape-b", "frame": 51,          // adds "position" and "velocity"
 //                    "position_weight": 1, "velocity_weight": 0.01} // objectives at the last frame
 //   }
-// The cloth block describes the cape; its top edge is pinned to the shoulder anchors whatever "pins" says.
+// The cloth block describes the cape; with anchors, its top edge is pinned to them whatever "pins" says:
+// top-edge particle i of nx follows the point at arc length i / (nx - 1) along the polyline through the
+// anchors' posed vertices (the edge stretches to the polyline's length; cloth.width need not match it).
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -46,8 +54,9 @@ struct Scene;
 // mesh `mesh` ("" = every mesh). It belongs to the character asset, so it is read from a file beside the
 // mesh unless the scene states it.
 struct CapeAnchors {
+  bool none = false;               // "none": the cloth is not pinned to the body
   std::string mesh;
-  std::vector<Vec3> points;        // empty when `nodes` names them
+  std::vector<Vec3> points;        // file frame; empty when `nodes` names them
   std::vector<std::string> nodes;  // empty when `points` gives them
   std::string where;  // "file: /json/pointer" of the block, for messages about names the mesh file lacks
 };
@@ -76,6 +85,9 @@ struct CharacterSpec {
   int animation = 0;
   std::vector<Vec2> time_keys{{0.0, 0.0}};  // (frame, seconds)
   Vec3 offset = Vec3::Zero();        // metres
+  double scale = 1.0;                // metres per file unit
+  bool z_up = false;                 // the file is Z-up: (x, y, z) -> (x, z, -y) after the scale
+  bool loop = false;                 // the animation repeats (else it holds its last pose)
   RootMotion root;
   CapeAnchors anchors;
   double body_thickness = 0.012;     // m: contact springs act within this distance of the body
@@ -99,7 +111,9 @@ struct CharacterSpec {
 
 // Animation time (seconds) at a (fractional) frame of the scene, by the spec's keys.
 double animation_time(const CharacterSpec& spec, double frame);
-// World-from-file transform at a (fractional) frame: the offset after the root motion.
+// Metres, Y up from the file's frame: the scale, then the rotation taking the file's up axis to +Y.
+Eigen::Affine3d character_conform(const CharacterSpec& spec);
+// World-from-file transform at a (fractional) frame: the conform, the root motion, then the offset.
 Eigen::Affine3d character_placement(const CharacterSpec& spec, double frame);
 
 // Reads the "character" block of a scene that already has its cloth and time; loads the start state and

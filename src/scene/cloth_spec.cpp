@@ -55,6 +55,31 @@ ColliderShape parse_capsule(Block& b) {
   return c;
 }
 
+ColliderShape parse_box(Block& b) {
+  BoxShape s;
+  s.center = b.vec3("center", s.center);
+  s.size = b.vec3("size", s.size, 1e-4, 1e4);
+  s.u_axis = unit_vec3(b, "u_axis", s.u_axis);
+  s.v_axis = unit_vec3(b, "v_axis", s.v_axis);
+  if (std::abs(s.u_axis.dot(s.v_axis)) > 1e-6) b.fail("v_axis", "expected a direction perpendicular to \"u_axis\"");
+  const double smallest = s.size.minCoeff();
+  s.radius = b.number("radius", std::min(s.radius, 0.5 * smallest), 1e-4, 1e4);
+  if (s.radius > 0.5 * smallest)
+    b.fail("radius", "expected at most half the smallest of \"size\" (the rounding fits inside the box)");
+  return s;
+}
+
+ColliderShape parse_rectangle(Block& b) {
+  RectangleShape s;
+  s.center = b.vec3("center", s.center);
+  s.u_axis = unit_vec3(b, "u_axis", s.u_axis);
+  s.v_axis = unit_vec3(b, "v_axis", s.v_axis);
+  if (std::abs(s.u_axis.dot(s.v_axis)) > 1e-6) b.fail("v_axis", "expected a direction perpendicular to \"u_axis\"");
+  s.width = b.number("width", s.width, 1e-4, 1e4);
+  s.height = b.number("height", s.height, 1e-4, 1e4);
+  return s;
+}
+
 struct ColliderType {
   const char* name;
   ColliderShape (*parse)(Block&);
@@ -64,6 +89,8 @@ const ColliderType kColliderTypes[] = {
     {SphereShape::kName, parse_sphere},
     {TorusShape::kName, parse_torus},
     {CapsuleShape::kName, parse_capsule},
+    {BoxShape::kName, parse_box},
+    {RectangleShape::kName, parse_rectangle},
 };
 
 ColliderSpec parse_collider(Block b) {
@@ -162,6 +189,18 @@ ClothSpec parse_cloth_spec(Block& b, const std::filesystem::path& directory) {
   s.transverse_ramp = b.number("transverse_ramp", s.transverse_ramp, 1e-4, 1.0);
   s.theta = b.number("theta", s.theta, 0.5, 1.0);
   for (Block& c : b.array("colliders")) s.colliders.push_back(parse_collider(std::move(c)));
+  s.self_stated = b.has("self");
+  if (s.self_stated) {
+    Block self = b.child("self");
+    // Pairs closer than the particle spacing repel: farther apart, a layer's particles slip between another's.
+    const double spacing = s.mesh ? s.self.thickness : std::min(s.width / (s.nx - 1), s.height / (s.ny - 1));
+    s.self.enabled = self.boolean("enabled", true);
+    s.self.thickness = self.number("thickness", spacing, 1e-5, 1.0);
+    s.self.stiffness = self.number("stiffness", s.self.stiffness, 0.0, 1e8);
+    s.self.friction = self.number("friction", s.self.friction, 0.0, 10.0);
+    s.self.friction_velocity = self.number("friction_velocity", s.self.friction_velocity, 1e-6, 100.0);
+    self.finish();
+  }
   b.finish();
   return s;
 }

@@ -45,7 +45,29 @@ struct CapsuleShape {
   double radius = 0.1;      // metres
 };
 
-using ColliderShape = std::variant<GroundShape, SphereShape, TorusShape, CapsuleShape>;
+// An oriented box with rounded edges and corners (a table, a shelf, a step): the points within `radius` of
+// the box of `size` shrunk by `radius` on every side. Its surface is smooth, so the push out of it turns
+// smoothly round an edge.
+struct BoxShape {
+  static constexpr const char* kName = "box";
+  Vec3 center = Vec3::Zero();
+  Vec3 size = Vec3(1, 1, 1);   // full extents along u_axis, v_axis and u_axis x v_axis, metres
+  Vec3 u_axis = Vec3::UnitX();  // unit
+  Vec3 v_axis = Vec3::UnitY();  // unit, perpendicular to u_axis
+  double radius = 0.02;         // rounding of the edges, metres (at most half the smallest size)
+};
+// A finite flat panel (a table top, a wall panel) of no thickness: `width` along u_axis, `height` along
+// v_axis. It pushes from both sides, away from the nearest point of the rectangle.
+struct RectangleShape {
+  static constexpr const char* kName = "rectangle";
+  Vec3 center = Vec3::Zero();
+  Vec3 u_axis = Vec3::UnitX();  // unit
+  Vec3 v_axis = Vec3::UnitZ();  // unit, perpendicular to u_axis; the panel's normal is u_axis x v_axis
+  double width = 1.0;           // metres
+  double height = 1.0;          // metres
+};
+
+using ColliderShape = std::variant<GroundShape, SphereShape, TorusShape, CapsuleShape, BoxShape, RectangleShape>;
 
 // A collider the cloth is pushed out of by stiff springs inside `thickness`, with smoothed Coulomb friction
 // (sim/cloth/friction.h) against sliding along it.
@@ -61,6 +83,16 @@ struct ColliderSpec {
 inline const char* type_name(const ColliderSpec& c) {
   return std::visit([](const auto& s) { return std::decay_t<decltype(s)>::kName; }, c.shape);
 }
+
+// Contact of the sheet with itself (sim/cape/self_collider.h): particle pairs closer than `thickness` repel,
+// with friction against their relative slip. A cape's comes from character.self.
+struct SelfContactSpec {
+  bool enabled = false;
+  double thickness = 0.01;           // m (cloth.self's default: the grid's particle spacing)
+  double stiffness = 500.0;          // N/m
+  double friction = 0;               // Coulomb coefficient (0: frictionless)
+  double friction_velocity = 0.01;   // m/s
+};
 
 struct ClothSpec {
   // cloth.mesh (scene/cloth_mesh_spec.h): the sheet is this mesh, particle i its vertex i; null: the grid
@@ -116,6 +148,8 @@ struct ClothSpec {
   // Below 1 the transverse stiffness needs a narrow transverse_ramp, or its explicit part grows.
   double theta = 1.0;
   std::vector<ColliderSpec> colliders;
+  SelfContactSpec self;                 // cloth.self (off by default)
+  bool self_stated = false;             // the scene gave a cloth.self block
 
   int particles() const { return mesh ? mesh->particles() : nx * ny; }
   bool direct_solver() const { return solver == "direct"; }

@@ -55,7 +55,8 @@ std::string cape_scene(int frames, int n, const std::string& anchors, const std:
          std::to_string(frames) + R"(},
   "cloth": {"nx": )" + std::to_string(n) +
          R"(, "ny": )" + std::to_string(n) + R"(, "pins": )" + (nodes ? R"("top_edge")" : "[0, 1]") + R"(,
-    "colliders": [{"type": "ground"}, {"type": "sphere"}, {"type": "torus"}, {"type": "capsule"}]},
+    "colliders": [{"type": "ground"}, {"type": "sphere"}, {"type": "torus"}, {"type": "capsule"},
+                  {"type": "box"}, {"type": "rectangle"}]},
   "character": {"file": "character.x", "anchors": )" +
          anchors + extra + R"(},
   "objectives": [{"type": "arch", "frame": 10, "axis_point": [0, 0, 0], "radius": 1},
@@ -74,7 +75,8 @@ std::string mesh_cloth_scene(int frames) {
   "time": {"frames": )" + std::to_string(frames) + R"(},
   "cloth": {"mesh": {"file": "cloth.obj", "scale": 1, "up_axis": "y", "rotation": {"axis": [0, 1, 0], "degrees": 0},
                      "offset": [0, 0, 0]},
-            "mass_by": "area", "pins": {"min": [-1, -1, -1], "max": [0.5, 1, 0.5]}},
+            "mass_by": "area", "pins": {"min": [-1, -1, -1], "max": [0.5, 1, 0.5]},
+            "self": {"enabled": true, "thickness": 0.02, "stiffness": 500, "friction": 0, "friction_velocity": 0.01}},
   "objectives": [{"type": "center_of_mass", "frame": 5, "particles": {"min": [0.5, -1, -1], "max": [2, 1, 2]},
                   "target": [0, 0, 0]}],
   "controls": {"kind": "per_frame"}
@@ -108,6 +110,7 @@ std::vector<ParamLog> every_branch_logs(const fs::path& scratch) {
                       "start": {"run": ")" + run + R"(", "frame": 0}, "end_target": {"run": ")" + run +
                        R"(", "frame": 1})"),
         cape_scene(z.frames, z.cloth_n, R"({"mesh": "Torso", "points": [[0, 0, 0], [1, 0, 0]]})", ""),
+        cape_scene(z.frames, z.cloth_n, R"("none")", R"(, "scale": 0.01, "up_axis": "z", "loop": true)"),
         mesh_cloth_scene(z.frames),
     };
     for (const std::string& text : texts) {

@@ -10,6 +10,7 @@
 #include <map>
 
 #include "render/export/export_run.h"
+#include "sim/cloth/collider.h"
 #include "synthetic_runs.h"
 
 namespace kf::render {
@@ -24,7 +25,10 @@ fs::path cloth_run_with_colliders(const fs::path& dir) {
       {"type": "sphere", "center": [0.2, 0.4, 0.1], "radius": 0.3},
       {"type": "torus", "center": [-0.4, 1.5, -0.3], "axis": [0, 0, 1], "radius": 0.25, "tube_radius": 0.03},
       {"type": "capsule", "a": [-1, 0.2, 0.5], "b": [1, 0.2, 0.5], "radius": 0.05},
-      {"type": "ground", "center": [0, -0.1, 0]}]}, "objectives": []})");
+      {"type": "ground", "center": [0, -0.1, 0]},
+      {"type": "box", "center": [0.5, -0.3, 0.2], "size": [0.6, 0.2, 0.4], "u_axis": [0.8, 0, 0.6], "radius": 0.05},
+      {"type": "rectangle", "center": [-0.5, 0.1, 0], "u_axis": [1, 0, 0], "v_axis": [0, 0.6, 0.8], "width": 0.5,
+       "height": 0.3}]}, "objectives": []})");
   return run;
 }
 
@@ -74,6 +78,23 @@ void expect_on_colliders(std::map<std::string, std::vector<Vec3>> meshes) {
   EXPECT_LT(lo, -1.0);
   EXPECT_GT(hi, 1.0);
   EXPECT_EQ(meshes["cloth"].size(), 64u);
+  // The box and the rectangle: every vertex on the surface their collider pushes out of.
+  const BoxCollider box(BoxShape{Vec3(0.5, -0.3, 0.2), Vec3(0.6, 0.2, 0.4), Vec3(0.8, 0, 0.6), Vec3::UnitY(), 0.05},
+                        0.01, 1, 0);
+  const BoxCollider panel(RectangleShape{Vec3(-0.5, 0.1, 0), Vec3::UnitX(), Vec3(0, 0.6, 0.8), 0.5, 0.3}, 0.01, 1, 0);
+  const auto phi = [](const BoxCollider& c) {
+    return [&c](const Vec3& p) {
+      double d;
+      Vec3 n;
+      Mat3 dn;
+      c.distance(p, d, n, dn);
+      return d;
+    };
+  };
+  EXPECT_GE(meshes["collider_4_box"].size(), 20u);
+  EXPECT_LT(worst(meshes["collider_4_box"], phi(box)), 1e-5);
+  EXPECT_GE(meshes["collider_5_rectangle"].size(), 4u);
+  EXPECT_LT(worst(meshes["collider_5_rectangle"], phi(panel)), 1e-6);
 }
 
 TEST(ColliderExport, ObjGltfAndPointCacheCarryEveryColliderShape) {
@@ -95,11 +116,12 @@ TEST(ColliderExport, ObjGltfAndPointCacheCarryEveryColliderShape) {
   }
   r.format = "pc2";
   const auto files = export_run(r);
-  EXPECT_EQ(files.size(), 10u);  // the cloth and four colliders: .obj and .pc2 each
+  EXPECT_EQ(files.size(), 14u);  // the cloth and six colliders: .obj and .pc2 each
   {
     SCOPED_TRACE("rest obj");
     std::map<std::string, std::vector<Vec3>> all;  // one object per rest OBJ
-    for (const char* name : {"cloth", "collider_0_sphere", "collider_1_torus", "collider_2_capsule", "collider_3_ground"})
+    for (const char* name : {"cloth", "collider_0_sphere", "collider_1_torus", "collider_2_capsule", "collider_3_ground",
+                             "collider_4_box", "collider_5_rectangle"})
       all.merge(read_meshes(run / "export" / (std::string(name) + ".obj")));
     expect_on_colliders(all);
   }

@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "sim/cloth/collider.h"
@@ -216,11 +217,142 @@ TEST(ClothCollider, CapsuleJacobianMatchesFiniteDifferences) {
   EXPECT_NEAR(out.f.dot(e), 0.0, 1e-12);
 }
 
+// The exact Jacobian at x (in contact) against central differences at two steps that agree with each
+// other and with it to 1e-6 of its size; the definite Jacobian NSD; the definite one's derivative.
+void check_contact_two_steps(const Collider& c, const Vec3& x, const std::string& what) {
+  ContactForce out;
+  ASSERT_TRUE(c.contact(0, x, Vec3::Zero(), false, out)) << what << " at " << x.transpose();
+  ASSERT_GT(out.f.norm(), 0) << what;
+  Mat3 fd[2];
+  const double steps[2] = {1e-6, 2e-7};
+  for (int s = 0; s < 2; ++s)
+    for (int k = 0; k < 3; ++k) {
+      Vec3 xp = x, xm = x;
+      xp[k] += steps[s];
+      xm[k] -= steps[s];
+      ContactForce p, m;
+      ASSERT_TRUE(c.contact(0, xp, Vec3::Zero(), false, p) && c.contact(0, xm, Vec3::Zero(), false, m)) << what;
+      fd[s].col(k) = (p.f - m.f) / (2 * steps[s]);
+    }
+  const double size = fd[0].norm();
+  ASSERT_GT(size, 0) << what;
+  EXPECT_LE((fd[0] - fd[1]).norm(), 1e-6 * size) << what << ": the two steps disagree";
+  EXPECT_LE((out.dfdx - fd[0]).norm(), 1e-6 * size) << what << "\nJ=\n" << out.dfdx << "\nfd=\n" << fd[0];
+  check_contact(c, x, what.c_str());
+}
+
+// A point at signed distance `depth` from a distance collider's surface: walk from `start` along its normal.
+Vec3 at_depth(const DistanceCollider& c, Vec3 x, double depth) {
+  for (int it = 0; it < 3; ++it) {  // once is exact where the nearest point does not change; repeat for safety
+    double phi;
+    Vec3 n;
+    Mat3 dn;
+    c.distance(x, phi, n, dn);
+    x -= (phi - depth) * n;
+  }
+  return x;
+}
+
+const BoxShape kBox{kCenter, Vec3(0.8, 0.3, 0.5), Vec3(1, 0.2, -0.1).normalized(),
+                    (kAxis - kAxis.dot(Vec3(1, 0.2, -0.1).normalized()) * Vec3(1, 0.2, -0.1).normalized()).normalized(),
+                    0.05};
+const RectangleShape kRectangle{kCenter, kBox.u_axis, kBox.v_axis, 0.6, 0.4};
+
+Mat3 axes_of(const Vec3& u, const Vec3& v) {
+  Mat3 r;
+  r << u, v, u.cross(v);
+  return r;
+}
+
+TEST(ClothCollider, BoxJacobianMatchesFiniteDifferencesOnFacesEdgesAndCorners) {
+  const BoxShape& s = kBox;
+  BoxCollider c(s, kThickness, kStiffness, kRamp);
+  const Mat3 axes = axes_of(s.u_axis, s.v_axis);
+  const Vec3 half = 0.5 * s.size - Vec3::Constant(s.radius);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> U(-0.8, 0.8), depth(-0.9 * kThickness, 0.9 * kThickness);
+  int checked = 0;
+  // Every face (one sign), edge (two) and corner (three), from outside and from inside the surface.
+  for (int a = -1; a <= 1; ++a)
+    for (int b = -1; b <= 1; ++b)
+      for (int d = -1; d <= 1; ++d) {
+        if (a == 0 && b == 0 && d == 0) continue;
+        const Vec3 sign(a, b, d);
+        for (int t = 0; t < 2; ++t) {
+          Vec3 q;
+          for (int k = 0; k < 3; ++k) q[k] = sign[k] != 0 ? sign[k] * (half[k] + 0.1) : U(rng) * half[k];
+          const Vec3 x = at_depth(c, s.center + axes * q, depth(rng));
+          check_contact_two_steps(c, x, "box region " + std::to_string(a) + "," + std::to_string(b) + "," +
+                                            std::to_string(d));
+          ++checked;
+        }
+      }
+  EXPECT_EQ(checked, 52);
+  check_whole_cloth_derivative(c, {at_depth(c, s.center + axes * Vec3(0, 1, 0), 0.4 * kThickness),
+                                   at_depth(c, s.center + axes * Vec3(1, 1, 0), -0.3 * kThickness),
+                                   at_depth(c, s.center + axes * Vec3(1, 1, 1), 0.7 * kThickness),
+                                   s.center + axes * Vec3(0, 2, 0)},
+                               "box");
+  // Out of reach beyond the thickness; deep inside (past the rounding) a finite push out of the nearest face.
+  ContactForce out;
+  EXPECT_FALSE(c.contact(0, at_depth(c, s.center + axes * Vec3(1, 1, 1), 1.01 * kThickness), Vec3::Zero(), false, out));
+  ASSERT_TRUE(c.contact(0, s.center + axes * Vec3(0, 0.5 * s.size.y() - 0.06, 0), Vec3::Zero(), false, out));
+  EXPECT_TRUE(out.f.allFinite() && out.dfdx.allFinite());
+  EXPECT_GT(out.f.dot(axes.col(1)), 0);
+  // Round an edge the normal turns continuously from one face's to the other's.
+  double phi;
+  Vec3 n0, n1;
+  Mat3 dn;
+  c.distance(s.center + axes * Vec3(half.x() - 1e-9, half.y() + s.radius, 0), phi, n0, dn);
+  c.distance(s.center + axes * Vec3(half.x() + 1e-9, half.y() + s.radius, 0), phi, n1, dn);
+  EXPECT_LT((n0 - n1).norm(), 1e-6);
+  EXPECT_NEAR(phi, 0.0, 1e-9);
+}
+
+TEST(ClothCollider, RectangleJacobianMatchesFiniteDifferencesOnBothSidesAndRoundItsEdges) {
+  const RectangleShape& s = kRectangle;
+  BoxCollider c(s, kThickness, kStiffness, kRamp);
+  const Mat3 axes = axes_of(s.u_axis, s.v_axis);
+  const Vec3 half(0.5 * s.width, 0.5 * s.height, 0);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> U(-0.8, 0.8), depth(0.1 * kThickness, 0.9 * kThickness);
+  int checked = 0;
+  for (int a = -1; a <= 1; ++a)
+    for (int b = -1; b <= 1; ++b)
+      for (int side : {-1, 1}) {
+        Vec3 q;
+        q[0] = a != 0 ? a * (half[0] + 0.05) : U(rng) * half[0];
+        q[1] = b != 0 ? b * (half[1] + 0.05) : U(rng) * half[1];
+        q[2] = side * 0.05;
+        const Vec3 x = at_depth(c, s.center + axes * q, depth(rng));
+        check_contact_two_steps(c, x, "rectangle region " + std::to_string(a) + "," + std::to_string(b) + " side " +
+                                          std::to_string(side));
+        ++checked;
+      }
+  EXPECT_EQ(checked, 18);
+  check_whole_cloth_derivative(c, {s.center + axes * Vec3(0.1, 0.05, 0.4 * kThickness),
+                                   s.center + axes * Vec3(0.1, -0.05, -0.6 * kThickness),
+                                   s.center + axes * Vec3(half.x() + 0.005, 0, 0.01),
+                                   s.center + axes * Vec3(0, 0, 3 * kThickness)},
+                               "rectangle");
+  // Within its footprint it pushes along its normal away from the side the particle is on; beyond its edge
+  // it does not reach a particle farther than the thickness; in its plane, a finite push.
+  ContactForce out;
+  ASSERT_TRUE(c.contact(0, s.center + axes * Vec3(0.1, 0.1, -0.5 * kThickness), Vec3::Zero(), false, out));
+  EXPECT_LT(out.f.dot(axes.col(2)), 0);
+  EXPECT_NEAR(out.f.cross(axes.col(2)).norm(), 0.0, 1e-9);
+  EXPECT_FALSE(c.contact(0, s.center + axes * Vec3(half.x() + 1.01 * kThickness, 0, 0), Vec3::Zero(), false, out));
+  ASSERT_TRUE(c.contact(0, s.center + axes * Vec3(0.1, 0.1, 0), Vec3::Zero(), false, out));
+  EXPECT_TRUE(out.f.allFinite() && out.dfdx.allFinite());
+}
+
 TEST(ClothCollider, FactoryBuildsOnePerSpecAndNoneForNone) {
   EXPECT_TRUE(make_colliders({}, 0.5).empty());
   const auto spec = [](ColliderShape shape) { return ColliderSpec{shape, kThickness, kStiffness}; };
-  auto cs = make_colliders({spec(kGround), spec(kSphere), spec(kTorus), spec(kCapsule)}, 0.5);
-  ASSERT_EQ(cs.size(), 4u);
+  auto cs = make_colliders({spec(kGround), spec(kSphere), spec(kTorus), spec(kCapsule), spec(kBox), spec(kRectangle)}, 0.5);
+  ASSERT_EQ(cs.size(), 6u);
+  EXPECT_NE(dynamic_cast<BoxCollider*>(cs[4].get()), nullptr);
+  EXPECT_NE(dynamic_cast<BoxCollider*>(cs[5].get()), nullptr);
   EXPECT_NE(dynamic_cast<TorusCollider*>(cs[2].get()), nullptr);
   EXPECT_NE(dynamic_cast<CapsuleCollider*>(cs[3].get()), nullptr);
 }

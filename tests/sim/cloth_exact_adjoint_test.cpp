@@ -99,6 +99,25 @@ const Case kCases[] = {
        "colliders": [{"type": "sphere", "center": [0, 0, 0], "radius": 0.1, "thickness": 0.03, "stiffness": 3000, "friction": 0}])",
      R"({"kind": "per_step", "alpha": 1e-4})",
      R"([{"type": "center_of_mass", "frame": 3, "weight": 100, "target": [0.05, 0.2, 0]}])", 1e-4},
+    // A sheet sliding with friction across a table (a box) and over its rounded edge, and one landing across
+    // the edge of a panel (a rectangle), part of it falling past.
+    {"box_edge_sliding", R"("origin": [-0.25, 0.012, -0.25], "v_axis": [0, 0, 1], "velocity": [1.5, -0.05, 0.4],
+       "colliders": [{"type": "box", "center": [0.05, -0.1, 0], "size": [0.5, 0.2, 0.6], "radius": 0.04,
+                      "thickness": 0.03, "stiffness": 3000, "friction": 0.6}])",
+     R"({"kind": "per_frame", "alpha": 1e-4})",
+     R"([{"type": "center_of_mass", "frame": 3, "weight": 100, "target": [0.2, 0.05, 0.1]}])", 1e-4},
+    {"rectangle_edge_landing", R"("origin": [-0.25, 0.02, -0.25], "v_axis": [0, 0, 1], "velocity": [0.3, -0.6, 0],
+       "colliders": [{"type": "rectangle", "center": [0.15, 0, 0], "width": 0.4, "height": 0.8, "thickness": 0.03,
+                      "stiffness": 3000, "friction": 0.4}])",
+     R"({"kind": "per_frame", "alpha": 1e-4})",
+     R"([{"type": "center_of_mass", "frame": 3, "weight": 100, "target": [0.1, 0.1, 0]}])", 1e-4},
+    // Self contact (cloth.self) thicker than the 0.1 m spacing, so neighbours press on each other as the
+    // sheet is compressed into an arch, with friction between them.
+    {"self_compressed_arch", R"("origin": [-0.25, 0, -0.25], "v_axis": [0, 0, 1], "gravity": [0, 0, 0],
+       "self": {"enabled": true, "thickness": 0.12, "stiffness": 300, "friction": 0.3})",
+     R"({"kind": "per_frame", "alpha": 1e-5})",
+     R"([{"type": "arch", "frame": 3, "weight": 100, "axis_point": [0, -0.2, 0], "axis": [0, 0, 1], "radius": 0.3}])",
+     1e-4},
     {"theta_explicit_compressed_arch", R"("origin": [-0.25, 0, -0.25], "v_axis": [0, 0, 1], "gravity": [0, 0, 0],
        "theta": 0.55, "transverse_ramp": 0.002, "control_integration": "explicit")",
      R"({"kind": "per_frame", "alpha": 1e-5})",

@@ -143,7 +143,11 @@ TEST(Friction, AnalyticCollidersMatchFiniteDifferences) {
   cols.push_back(std::make_unique<TorusCollider>(TorusShape{kCenter, kAxis, 0.4, 0.05}, kThickness, kStiffness, kRamp));
   cols.push_back(std::make_unique<CapsuleCollider>(CapsuleShape{kCenter, kCenter + Vec3(0.5, 0.3, -0.2), 0.1},
                                                    kThickness, kStiffness, kRamp));
-  const char* names[] = {"ground", "sphere", "torus", "capsule"};
+  const Vec3 u = Vec3(1, 0.2, -0.1).normalized(), v = (kAxis - kAxis.dot(u) * u).normalized();
+  cols.push_back(std::make_unique<BoxCollider>(BoxShape{kCenter, Vec3(0.8, 0.3, 0.5), u, v, 0.05}, kThickness,
+                                               kStiffness, kRamp));
+  cols.push_back(std::make_unique<BoxCollider>(RectangleShape{kCenter, u, v, 0.6, 0.4}, kThickness, kStiffness, kRamp));
+  const char* names[] = {"ground", "sphere", "torus", "capsule", "box", "rectangle"};
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> U(-0.9, 0.9);
   for (size_t k = 0; k < cols.size(); ++k) {

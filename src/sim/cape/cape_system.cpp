@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <cstdio>
 #include <sstream>
 
 #include "core/error.h"
@@ -45,23 +46,39 @@ void warn_if_pins_jump(const ClothSpec& c, const std::vector<Vec3>& anchors, con
   warn(msg);
 }
 
+// Each anchor point snaps to its nearest bind-pose vertex; farther than this is a point off the body (or
+// in the wrong units) that the cape will not hang from.
+constexpr double kSnapWarning = 0.005;  // m
+
+void warn_if_anchors_snap(const Character& character, const CapeAnchors& anchors, const std::vector<int>& ids,
+                          const std::string& where) {
+  const std::vector<Vec3> points = cape_anchor_points(character, anchors);
+  double worst = 0;
+  size_t worst_k = 0;
+  for (size_t k = 0; k < ids.size(); ++k) {
+    const double d = (seg(character.bind_vertices(), ids[k]) - character.placement() * points[k]).norm();
+    if (d > worst) worst = d, worst_k = k;
+  }
+  if (worst <= kSnapWarning) return;
+  char msg[512];
+  std::snprintf(msg, sizeof msg,
+                "%s/anchors: anchor %zu is %.3f m from the nearest vertex of the body, which the cape's edge hangs from "
+                "instead (anchors snap to vertices; move the point onto the surface, or check character.scale)",
+                where.c_str(), worst_k, worst);
+  warn(msg);
+}
+
 }  // namespace
 
-
-CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, double fps, int steps, double h)
-    : spec_(character), fps_(fps), h_(h), character_(load_character(character, int(std::lround(steps * h * fps)))),
-      cape_length_(cloth.height) {
-  if (cloth.mesh) throw InputError(cloth.mesh->file + ": a cape on a character is a grid cloth (cloth.mesh is not for capes yet)");
-  ClothSpec c = cloth;
+std::unique_ptr<PinTrack> CapeSystem::anchor_track(ClothSpec& c, const CharacterSpec& character, int steps) {
   c.pins = named_pin_set("top_edge", c.nx, c.ny);
-  // The moving body does work on the cape that a step's energy check cannot account for, so cape steps
-  // are never split (its scenes use small steps).
-  c.max_halvings = 0;
+  // Top-edge particle k of nx follows the point at arc length k / (nx - 1) along the anchors' polyline.
   std::vector<double> params;
   for (int k = 0; k < int(c.pins.size()); ++k) params.push_back(c.nx > 1 ? double(k) / (c.nx - 1) : 0.5);
 
   // The pins' path over the whole run (one pose per step, plus one past the end for the last velocity).
   const std::vector<int> anchor_ids = cape_anchor_vertices(character_, character.anchors);
+  warn_if_anchors_snap(character_, character.anchors, anchor_ids, character.where);
   std::vector<std::vector<Vec3>> anchors;
   VecX gathered;
   for (int n = 0; n <= steps + 1; ++n) {
@@ -71,8 +88,20 @@ CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, d
     for (size_t k = 0; k < a.size(); ++k) a[k] = seg(gathered, int(k));
     anchors.push_back(std::move(a));
   }
-  auto track = std::make_unique<AnchorTrack>(anchors, c.pins, params, c.particles(), h);
   if (character.start_x.size() == 0) warn_if_pins_jump(c, anchors[0], params, character.where);
+  return std::make_unique<AnchorTrack>(anchors, c.pins, params, c.particles(), h_);
+}
+
+CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, double fps, int steps, double h)
+    : spec_(character), fps_(fps), h_(h), character_(load_character(character, int(std::lround(steps * h * fps)))),
+      cape_length_(cloth.height) {
+  if (cloth.mesh) throw InputError(cloth.mesh->file + ": a cape on a character is a grid cloth (cloth.mesh is not for capes yet)");
+  ClothSpec c = cloth;
+  // The moving body does work on the cape that a step's energy check cannot account for, so cape steps
+  // are never split (its scenes use small steps).
+  c.max_halvings = 0;
+  std::unique_ptr<PinTrack> track;  // none: the cloth's own pins hold still
+  if (!character.anchors.none) track = anchor_track(c, character, steps);
 
   std::vector<std::unique_ptr<Collider>> extra;
   auto body = std::make_unique<BodyCollider>(character_.triangles(), character_.vertex_count(),
@@ -123,7 +152,6 @@ void CapeSystem::prepare(int n, const VecX& x, const VecX& v) {
     }
     posed_step_ = n;
   }
-  if (self_) self_->update(x, v);
 }
 
 void CapeSystem::set_adjoint(AdjointKind kind) {

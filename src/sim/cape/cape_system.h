@@ -19,7 +19,8 @@ namespace kf {
 
 class CapeSystem final : public System {
  public:
-  // cloth: the cape (its top edge is pinned to the anchors whatever cloth.pins says); fps: frames per
+  // cloth: the cape (with anchors, its top edge is pinned to them whatever cloth.pins says; with
+  // anchors "none", cloth.pins hold still and a free sheet can fall onto the body); fps: frames per
   // second of the scene (for the time remap); steps: how many steps the run has (poses precomputed for
   // the pins); h: step length, s. Throws InputError when the character file cannot be loaded.
   CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, double fps, int steps, double h);
@@ -63,6 +64,8 @@ class CapeSystem final : public System {
 
  private:
   void prepare(int n, const VecX& x, const VecX& v);  // body at step n (and its velocity), self hash of x, v
+  // Pins c's top edge to the anchors (spread by arc length along them) and returns their path over the run.
+  std::unique_ptr<PinTrack> anchor_track(ClothSpec& c, const CharacterSpec& character, int steps);
 
   CharacterSpec spec_;
   double fps_, h_;

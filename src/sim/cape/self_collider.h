@@ -28,6 +28,7 @@ class SelfCollider final : public Collider {
   // calls see. Allocation-free. Without velocities every particle counts as still.
   void update(const VecX& x);
   void update(const VecX& x, const VecX& v);
+  void set_state(const VecX& x, const VecX& v) override { update(x, v); }
 
   // Sums the pairs of the particle at x (it must be one of the updated positions; the particle itself is
   // recognised by its identical position). df/dx: per pair -g' n n^T, plus g/r (I - n n^T) unless

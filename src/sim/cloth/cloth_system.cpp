@@ -9,6 +9,7 @@
 #include <tbb/partitioner.h>
 
 #include "core/error.h"
+#include "sim/cape/self_collider.h"
 #include "sim/cloth/imperfection.h"
 #include "sim/cloth/mesh_layout.h"
 #include "sim/make_system.h"
@@ -120,6 +121,7 @@ void ClothSystem::initial_state(VecX& x, VecX& v) const {
 }
 
 void ClothSystem::assemble(int n, const VecX& x, const VecX& v, double hs, bool forces) {
+  for (auto& c : colliders_) c->set_state(x, v);
   assembly_.assemble(ClothState{n, x, v, mass_, free_}, hs > 0 ? hs : h_, forces);
   if (direct_solve_) direct_ok_ = direct_.factor(assembly_.matrix(), free_);
   else pcg_.prepare(assembly_.matrix(), free_);
@@ -365,7 +367,15 @@ std::string ClothSystem::describe() const {
 }
 
 std::unique_ptr<System> make_cloth_system(const Scene& scene, double h) {
-  auto sys = std::make_unique<ClothSystem>(*scene.cloth, h);
+  const ClothSpec& c = *scene.cloth;
+  std::vector<std::unique_ptr<Collider>> extra;
+  if (c.self.enabled) {  // the same term as a cape's self contact
+    auto self = std::make_unique<SelfCollider>(c.particles(), c.self.thickness, c.self.stiffness,
+                                               c.contact_ramp * c.self.thickness);
+    self->set_friction({c.self.friction, c.self.friction_velocity});
+    extra.push_back(std::move(self));
+  }
+  auto sys = std::make_unique<ClothSystem>(c, h, nullptr, std::move(extra));
   sys->set_adjoint(adjoint_kind(scene.optimizer.adjoint));
   return sys;
 }

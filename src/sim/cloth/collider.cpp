@@ -181,6 +181,55 @@ void CapsuleCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& d
   dnormal_dx = side ? Mat3(across * (Mat3::Identity() - axis_ * axis_.transpose())) : across;
 }
 
+namespace {
+Mat3 frame_of(const Vec3& u, const Vec3& v) {
+  Mat3 r;
+  r.col(0) = u.normalized();
+  r.col(1) = v.normalized();
+  r.col(2) = r.col(0).cross(r.col(1));
+  return r;
+}
+}  // namespace
+
+BoxCollider::BoxCollider(const BoxShape& s, double thickness, double stiffness, double ramp)
+    : DistanceCollider(thickness, stiffness, ramp),
+      center_(s.center),
+      axes_(frame_of(s.u_axis, s.v_axis)),
+      half_((0.5 * s.size - Vec3::Constant(s.radius)).cwiseMax(0.0)),
+      radius_(s.radius) {}
+
+BoxCollider::BoxCollider(const RectangleShape& s, double thickness, double stiffness, double ramp)
+    : DistanceCollider(thickness, stiffness, ramp),
+      center_(s.center),
+      axes_(frame_of(s.u_axis, s.v_axis)),
+      half_(0.5 * s.width, 0.5 * s.height, 0.0),
+      radius_(0.0) {}
+
+void BoxCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const {
+  const Vec3 q = axes_.transpose() * (x - center_);  // in the box's frame
+  const Vec3 w = q - q.cwiseMax(-half_).cwiseMin(half_);  // from the inner box's nearest point
+  const double d = w.norm();
+  const double scale = std::max(half_.maxCoeff(), radius_);
+  if (d <= 1e-12 * scale) {
+    // Inside the inner box (a rectangle: in its plane): out through the nearest face; n is constant
+    // between the medial planes, where it jumps.
+    int k = 0;
+    const Vec3 gap = q.cwiseAbs() - half_;
+    gap.maxCoeff(&k);
+    phi = gap[k] - radius_;
+    normal = (q[k] < 0 ? -1.0 : 1.0) * axes_.col(k);
+    dnormal_dx.setZero();
+    return;
+  }
+  phi = d - radius_;
+  const Vec3 nl = w / d;
+  normal = axes_ * nl;
+  // dn/dx = R (I - nl nl^T)/d dw/dq R^T, dw/dq = 1 on the axes where q is beyond the inner box, else 0.
+  Mat3 dw = Mat3::Zero();
+  for (int k = 0; k < 3; ++k) dw(k, k) = std::abs(q[k]) > half_[k] ? 1.0 : 0.0;
+  dnormal_dx = axes_ * ((Mat3::Identity() - nl * nl.transpose()) / d * dw) * axes_.transpose();
+}
+
 std::vector<std::unique_ptr<Collider>> make_colliders(const std::vector<ColliderSpec>& specs, double ramp_fraction) {
   std::vector<std::unique_ptr<Collider>> out;
   for (const ColliderSpec& s : specs) {
@@ -198,6 +247,12 @@ std::vector<std::unique_ptr<Collider>> make_colliders(const std::vector<Collider
             },
             [&](const CapsuleShape& g) -> std::unique_ptr<Collider> {
               return std::make_unique<CapsuleCollider>(g, s.thickness, s.stiffness, ramp);
+            },
+            [&](const BoxShape& g) -> std::unique_ptr<Collider> {
+              return std::make_unique<BoxCollider>(g, s.thickness, s.stiffness, ramp);
+            },
+            [&](const RectangleShape& g) -> std::unique_ptr<Collider> {
+              return std::make_unique<BoxCollider>(g, s.thickness, s.stiffness, ramp);
             },
         },
         s.shape));

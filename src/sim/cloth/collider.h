@@ -35,6 +35,9 @@ struct ContactForce {
 class Collider {
  public:
   virtual ~Collider() = default;
+  // The state (x, v: 3p) every contact query until the next call is about: the cloth calls it before each
+  // assembly. Only a pair collider (self contact) reads it, to find each particle's neighbours.
+  virtual void set_state(const VecX& /*x*/, const VecX& /*v*/) {}
   // Contact of a particle at x (m) with velocity v (m/s) at step n. Returns false (and leaves `out`
   // untouched) when there is no contact. `definite` keeps only the Jacobian part that stiffens the
   // implicit matrix (-k n n^T), dropping curvature terms that could make it indefinite; the exact
@@ -140,6 +143,24 @@ class CapsuleCollider final : public DistanceCollider {
  private:
   Vec3 a_, axis_;  // one end and the unit direction to the other
   double length_, radius_;
+};
+
+// A box with rounded edges: the points within `radius` of an oriented inner box (half extents e, which
+// may be 0 along an axis). A BoxShape's inner box is its size shrunk by the rounding; a RectangleShape is
+// an inner box of no depth and no rounding, so it pushes within its thickness from either side, away from
+// its nearest point. phi and n are continuous everywhere but inside the inner box's medial planes, deeper
+// than `radius` (a rectangle: only in its own plane, where n is its normal on the side u x v points to).
+class BoxCollider final : public DistanceCollider {
+ public:
+  BoxCollider(const BoxShape& s, double thickness, double stiffness, double ramp);
+  BoxCollider(const RectangleShape& s, double thickness, double stiffness, double ramp);
+  void distance(const Vec3& x, double& phi, Vec3& normal, Mat3& dnormal_dx) const override;
+
+ private:
+  Vec3 center_;
+  Mat3 axes_;     // columns: the box's unit axes (world from box)
+  Vec3 half_;     // the inner box's half extents along them, metres
+  double radius_;
 };
 
 // One collider per spec entry, in order, each shape's class chosen by std::visit (empty for a scene without colliders). ramp_fraction: each
