@@ -8,6 +8,7 @@
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -84,11 +85,20 @@ scene.frame_set(25)
 goal = empty.matrix_world.translation.copy()
 miss = (played_back_corner(25) - goal).length
 rest_miss = (played_back_corner(1) - world[corner]).length
-print(f"solve: {time.time() - started:.1f} s; corner at frame 25 is {100 * miss:.3f} cm from the Empty; "
+solve_s = time.time() - started
+print(f"solve: {solve_s:.1f} s; corner at frame 25 is {100 * miss:.3f} cm from the Empty; "
       f"at frame 1 {100 * rest_miss:.3f} cm from its rest place; {scene.keyframe.status}")
 assert miss < 0.01, miss
 assert rest_miss < 0.002, rest_miss  # frame 1 is the rest shape (up to keyframe's imperfection)
 assert cloth.modifiers["keyframe"].type == 'MESH_CACHE'
+solved = json.load(open(os.path.join(work, "Sheet-run", "report.json")))
+keep = os.environ.get("KEYFRAME_BLENDER_KEEP")  # scripts/blender/shot_results keeps the solved shot
+if keep:
+    shutil.copytree(work, keep)
+    with open(os.path.join(keep, "results.csv"), "w") as f:
+        f.write("particles,frames,evaluations,solve_s,played_back_miss_cm,status\n"
+                f"{len(world)},{solved['steps']},{solved['evaluations']},{solve_s:.2f},{100 * miss:.3f},"
+                f"{solved['status']}\n")
 
 # 2. The written scene: keyframe's own frame (Y up) and it validates against `keyframe schema`.
 path = os.path.join(work, "Sheet.json")
