@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/warnings.h"
 #include "sim/cape/anchor_track.h"
+#include "sim/cape/skin_pin_track.h"
 #include "sim/character/cape_anchors.h"
 #include "sim/character/scene_character.h"
 #include "sim/make_system.h"
@@ -68,6 +69,13 @@ void warn_if_anchors_snap(const Character& character, const CapeAnchors& anchors
   warn(msg);
 }
 
+// A mesh cape's length for the measures: the largest side of its rest mesh's box.
+double mesh_extent(const ClothMesh& m) {
+  Vec3 lo = m.vertices[0], hi = m.vertices[0];
+  for (const Vec3& v : m.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  return (hi - lo).maxCoeff();
+}
+
 }  // namespace
 
 std::unique_ptr<PinTrack> CapeSystem::anchor_track(ClothSpec& c, const CharacterSpec& character, int steps) {
@@ -94,14 +102,18 @@ std::unique_ptr<PinTrack> CapeSystem::anchor_track(ClothSpec& c, const Character
 
 CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, double fps, int steps, double h)
     : spec_(character), fps_(fps), h_(h), character_(load_character(character, int(std::lround(steps * h * fps)))),
-      cape_length_(cloth.height) {
-  if (cloth.mesh) throw InputError(cloth.mesh->file + ": a cape on a character is a grid cloth (cloth.mesh is not for capes yet)");
+      cape_length_(cloth.mesh ? mesh_extent(*cloth.mesh) : cloth.height) {
   ClothSpec c = cloth;
   // The moving body does work on the cape that a step's energy check cannot account for, so cape steps
   // are never split (its scenes use small steps).
   c.max_halvings = 0;
-  std::unique_ptr<PinTrack> track;  // none: the cloth's own pins hold still
-  if (!character.anchors.none) track = anchor_track(c, character, steps);
+  std::unique_ptr<PinTrack> track;  // none: the cloth's own pins hold still (a free sheet falls onto the body)
+  if (cloth.mesh) {
+    // A mesh cloth's own pins follow the skin; without pins and without anchors it is free.
+    if (!(cloth.pins.empty() && character.anchors.none)) track = skin_pin_track(character_, character, c, fps, steps, h);
+  } else if (!character.anchors.none) {
+    track = anchor_track(c, character, steps);
+  }
 
   std::vector<std::unique_ptr<Collider>> extra;
   auto body = std::make_unique<BodyCollider>(character_.triangles(), character_.vertex_count(),
