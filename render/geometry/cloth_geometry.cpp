@@ -33,9 +33,11 @@ void add_collider(Mesh& m, const ColliderShape& shape, const Vec3& color) {
                    add_rounded_box(m, s.center, box_axes(s.u_axis, s.v_axis), 0.5 * s.size - Vec3::Constant(s.radius),
                                    s.radius, color);
                  },
-                 [&](const RectangleShape& s) {
-                   add_rounded_box(m, s.center, box_axes(s.u_axis, s.v_axis), Vec3(0.5 * s.width, 0.5 * s.height, 0),
-                                   0.0, color);
+                 [&](const RectangleShape& s) {  // both sides, each facing out
+                   const Mat3 r = box_axes(s.u_axis, s.v_axis);
+                   const Vec3 u = 0.5 * s.width * r.col(0), v = 0.5 * s.height * r.col(1), c = s.center;
+                   add_flat_quad(m, c - u - v, c + u - v, c + u + v, c - u + v, r.col(2), color);
+                   add_flat_quad(m, c - u - v, c - u + v, c + u + v, c + u - v, -r.col(2), color);
                  },
              },
              shape);

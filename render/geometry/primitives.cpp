@@ -136,30 +136,34 @@ void add_capsule(Mesh& m, const Vec3& a, const Vec3& b, double r, const Vec3& co
 }
 
 void add_rounded_box(Mesh& m, const Vec3& c, const Mat3& axes, const Vec3& half, double r, const Vec3& color) {
-  const auto corner = [&](const Vec3& s) { return Vec3(c + axes * half.cwiseProduct(s)); };
-  for (int k = 0; k < 3; ++k) {
-    const int a = (k + 1) % 3, b = (k + 2) % 3;
-    for (const double side : {-1.0, 1.0}) {
-      // The face across axis k on `side`: its outward normal and its corners, counter-clockwise from outside.
-      const Vec3 n = side * axes.col(k), mid = c + axes.col(k) * (side * (half[k] + r));
-      const Vec3 ua = axes.col(a) * half[a], ub = axes.col(b) * half[b];
-      if (side > 0) add_flat_quad(m, mid - ua - ub, mid + ua - ub, mid + ua + ub, mid - ua + ub, n, color);
-      else add_flat_quad(m, mid - ua - ub, mid - ua + ub, mid + ua + ub, mid + ua - ub, n, color);
-      // The edges along axis k (four of them, each met twice over the loop over sides: draw at side > 0).
-      if (r <= 0 || side < 0) continue;
-      for (const double sa : {-1.0, 1.0})
-        for (const double sb : {-1.0, 1.0}) {
-          Vec3 s0 = Vec3::Zero();
-          s0[a] = sa;
-          s0[b] = sb;
-          Vec3 s1 = s0;
-          s0[k] = -1;
-          s1[k] = 1;
-          const Vec3 p0 = corner(s0), p1 = corner(s1);
-          if ((p1 - p0).norm() > 1e-9 * std::max(r, 1.0)) add_capsule(m, p0, p1, r, color);
-          else add_sphere(m, p0, r, color);
-        }
+  // A sphere of radius r split at its three great circles, each octant moved out to its corner of the
+  // box: every angle where a sign changes is taken twice (once per side), so the strips between them are
+  // the flat faces and the edges' cylinders. Only the two faces across axis 1 (at the poles) are added flat.
+  constexpr int kArc = 6;              // segments per quarter circle
+  constexpr int kU = 4 * (kArc + 1);   // around axis 1 (columns; the last strip closes the loop)
+  constexpr int kV = 2 * (kArc + 1);   // pole to pole (rows)
+  const uint32_t base = uint32_t(m.vertices.size());
+  for (int j = 0; j < kV; ++j) {
+    const int hemi = j / (kArc + 1), jj = j % (kArc + 1);
+    const double theta = 0.5 * M_PI * (hemi + double(jj) / kArc);
+    for (int i = 0; i < kU; ++i) {
+      const int quarter = i / (kArc + 1), ii = i % (kArc + 1);
+      const double phi = 0.5 * M_PI * (quarter + double(ii) / kArc), mid = 0.5 * M_PI * (quarter + 0.5);
+      const Vec3 n(std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi));
+      const Vec3 sign(std::cos(mid) > 0 ? 1 : -1, hemi == 0 ? 1 : -1, -std::sin(mid) > 0 ? 1 : -1);
+      add_vertex(m, c + axes * (half.cwiseProduct(sign) + r * n), axes * n, color, color);
     }
+  }
+  for (int j = 0; j + 1 < kV; ++j)
+    for (int i = 0; i < kU; ++i) {
+      const uint32_t a = base + j * kU + i, b = base + j * kU + (i + 1) % kU, d = a + kU, e = b + kU;
+      m.indices.insert(m.indices.end(), {a, b, e, a, e, d});
+    }
+  for (const double side : {-1.0, 1.0}) {
+    const Vec3 n = side * axes.col(1), mid = c + axes.col(1) * (side * (half.y() + r));
+    const Vec3 ua = axes.col(0) * half.x(), ub = axes.col(2) * half.z();
+    if (side > 0) add_flat_quad(m, mid - ua + ub, mid + ua + ub, mid + ua - ub, mid - ua - ub, n, color);
+    else add_flat_quad(m, mid - ua - ub, mid + ua - ub, mid + ua + ub, mid - ua + ub, n, color);
   }
 }
 

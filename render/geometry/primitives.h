@@ -27,7 +27,7 @@ void add_sphere(Mesh& m, const Vec3& center, double r, const Vec3& color);
 void add_torus(Mesh& m, const Vec3& center, const Vec3& axis, double R, double r, const Vec3& color);
 void add_capsule(Mesh& m, const Vec3& a, const Vec3& b, double r, const Vec3& color);
 // A box with rounded edges: the points within r of the box centred at c with unit axes `axes` (columns)
-// and half extents `half` (each may be 0): six flat faces and a capsule along each of its twelve edges.
+// and half extents `half` (each may be 0): one closed surface, every vertex on it.
 void add_rounded_box(Mesh& m, const Vec3& c, const Mat3& axes, const Vec3& half, double r, const Vec3& color);
 // Three crossed bars of half-size s (m) at c: a keyframe target.
 void add_marker(Mesh& m, const Vec3& c, double s, const Vec3& color);

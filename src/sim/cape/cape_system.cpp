@@ -48,8 +48,9 @@ void warn_if_pins_jump(const ClothSpec& c, const std::vector<Vec3>& anchors, con
 }
 
 // Each anchor point snaps to its nearest bind-pose vertex; farther than this is a point off the body (or
-// in the wrong units) that the cape will not hang from.
-constexpr double kSnapWarning = 0.005;  // m
+// in the wrong units) that the cape will not hang from. The shipped character's own anchors lie up to
+// 12 mm from their vertices (tests/sim/character_cape_anchor_test.cpp), so the bound sits above that.
+constexpr double kSnapWarning = 0.02;  // m
 
 void warn_if_anchors_snap(const Character& character, const CapeAnchors& anchors, const std::vector<int>& ids,
                           const std::string& where) {

@@ -210,16 +210,18 @@ Character::Character(const std::filesystem::path& file, const CharacterOptions& 
   const aiScene* scene = owned.get();
   if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !scene->mRootNode || scene->mNumMeshes == 0)
     throw InputError(name + ": character file has no complete mesh");
-  if (scene->mNumAnimations == 0) throw InputError(name + ": character file has no animation");
-  if (options.animation < 0 || options.animation >= static_cast<int>(scene->mNumAnimations))
+  // A file without animation is a static body (animation 0 then means "none").
+  const bool animated = scene->mNumAnimations > 0;
+  if (options.animation < 0 || (animated && options.animation >= static_cast<int>(scene->mNumAnimations)) ||
+      (!animated && options.animation != 0))
     throw InputError(name + ": animation " + std::to_string(options.animation) + " requested, file has " +
                      std::to_string(scene->mNumAnimations));
 
   std::unordered_map<std::string, int> by_name;
   read_nodes(*scene, by_name);
-  read_channels(*scene, scene->mAnimations[options.animation], by_name);
-  read_meshes(*scene, by_name, name);
-  if (bones_.empty() || channels_.empty()) throw InputError(name + ": character file has no skinned bones");
+  if (animated) read_channels(*scene, scene->mAnimations[options.animation], by_name);
+  read_meshes(*scene, by_name, name);  // every vertex gets a bone: its mesh's node's when no bone moves it
+  if (bones_.empty()) throw InputError(name + ": character file has no bones");
   if (triangles_.rows() == 0) throw InputError(name + ": character file has no triangles");
 
   world_.assign(nodes_.size(), Affine::Identity());

@@ -62,8 +62,9 @@ class Character {
   // Maximum bone influences per vertex kept after assimp's LimitBoneWeights step.
   static constexpr int kMaxInfluences = 4;
 
-  // Loads `file` (any format assimp reads with bones and an animation). Throws InputError naming the file
-  // when it is missing, unreadable, truncated, has no mesh, no bones or no animation.
+  // Loads `file` (any format assimp reads; meshes no bone moves follow their node, and a file without
+  // animation is a static body of duration 0). Throws InputError naming the file when it is missing,
+  // unreadable, truncated or has no mesh.
   explicit Character(const std::filesystem::path& file, const CharacterOptions& options = {});
 
   const std::string& file() const { return file_; }  // as given to the constructor, for messages

@@ -28,7 +28,7 @@ Character load_character(const CharacterSpec& spec, int frames) {
   try {
     Character c(spec.file, character_options(spec));
     warn_if_frozen(spec);
-    if (spec.loop) return c;  // a looped clip never ends
+    if (spec.loop || c.duration() <= 0) return c;  // a looped clip never ends; a static body has none
     const double end = animation_time(spec, frames);
     // A pose held for less than a millisecond past the end is the end pose: a clip's duration and the
     // scene's frames at its fps differ by round-off (0.967 s against 29 / 30 s) without anything to say.
