@@ -23,7 +23,7 @@ struct MeshImportOptions {
   unsigned seconds = kMeshImportSeconds;  // the isolated import's time limit
 };
 
-// The scene as assimp read it (faces that are not triangles dropped; see mesh_wire.h), with its
+// The scene as assimp read it (points and lines dropped; see mesh_wire.h), with its
 // AI_SCENE_FLAGS_INCOMPLETE flag as assimp set it. Throws InputError "FILE: ..." when the file is not a
 // regular file under the cap, assimp refuses or crashes on it, it opens another file that is not regular
 // or too large, or it holds a non-finite value.
