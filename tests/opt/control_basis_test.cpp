@@ -80,11 +80,19 @@ TEST_P(EachBasis, FitRecoversWhatSpreadGaveOrIsRefusedForARigidMotion) {
         const VecX z = random_vector(b.size(), 3);
         VecX spread = VecX::Zero(3 * p), fitted(b.size());
         b.spread(z.data(), spread);
-        if (which == ControlBasis::kRigid) return EXPECT_THROW(b.fit(spread, fitted.data()), std::logic_error);
+        if (which == ControlBasis::kRigid) {
+          EXPECT_THROW(b.fit(spread, fitted.data()), std::logic_error);
+          return;
+        }
         b.fit(spread, fitted.data());
         EXPECT_LT((fitted - z).norm(), 1e-8 * z.norm());
       },
       basis);
+}
+
+std::string basis_name(const ::testing::TestParamInfo<std::pair<ControlBasis, bool>>& info) {
+  const char* const names[] = {"particle", "lattice", "rigid"};
+  return std::string(names[int(info.param.first)]) + (info.param.second ? "_planar" : "");
 }
 
 INSTANTIATE_TEST_SUITE_P(Bases, EachBasis,
@@ -94,10 +102,7 @@ INSTANTIATE_TEST_SUITE_P(Bases, EachBasis,
                                            std::pair{ControlBasis::kLattice, true},
                                            std::pair{ControlBasis::kRigid, false},
                                            std::pair{ControlBasis::kRigid, true}),
-                         [](const ::testing::TestParamInfo<std::pair<ControlBasis, bool>>& info) {
-                           const char* names[] = {"particle", "lattice", "rigid"};
-                           return std::string(names[int(info.param.first)]) + (info.param.second ? "_planar" : "");
-                         });
+                         basis_name);
 
 // Controls: the size is blocks × the basis' size, blocks from the timing.
 TEST(ControlsAxes, SizeIsTheTimingsBlocksTimesTheBasisSize) {
