@@ -67,11 +67,22 @@ TEST(CharacterLoad, GarbageIsAnInputErrorNamingIt) {
   expect_input_error_naming(garbage);
 }
 
-TEST(CharacterLoad, StaticMeshWithoutAnimationIsAnInputErrorNamingIt) {
+// A file without animation (or bones) is a still body: its vertices follow their node, duration 0.
+TEST(CharacterLoad, StaticMeshWithoutAnimationLoadsAsAStillBody) {
   test::TempDir dir;
   const auto obj = dir.path() / "triangle.obj";
   std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-  expect_input_error_naming(obj);
+  Character c(obj);
+  EXPECT_EQ(c.vertex_count(), 3);
+  EXPECT_EQ(c.duration(), 0.0);
+  VecX at0, at1;
+  c.pose(0.0, at0);
+  c.pose(1.0, at1);
+  EXPECT_EQ(at0, at1);
+  EXPECT_LT((at0 - c.bind_vertices()).norm(), 1e-12);
+  CharacterOptions later;
+  later.animation = 1;
+  EXPECT_THROW(Character(obj, later), InputError);  // it has no animation 1
 }
 
 }  // namespace
