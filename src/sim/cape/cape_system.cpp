@@ -17,8 +17,8 @@ namespace kf {
 namespace {
 
 // The cloth block lays the sheet out flat; its pinned edge then jumps to the anchors in the first step.
-// More than 10 cm is almost always a cloth block that does not match the character (the shipped capes start
-// 8 cm behind theirs, off the back).
+// More than 10 cm is almost always a cloth block that does not match the character (a cape laid out a few
+// centimetres off its body's back is normal).
 constexpr double kPinJumpWarning = 0.10;  // m
 
 void warn_if_pins_jump(const ClothSpec& c, const std::vector<Vec3>& anchors, const std::vector<double>& params,
