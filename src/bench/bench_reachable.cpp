@@ -124,6 +124,8 @@ SceneRun run_scene(const ReachableSweepOptions& o, const std::string& name, cons
   }
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   run.cpu_seconds = process_cpu_seconds() - cpu_start;
+  // A job cut before its first evaluation (a long throw search) writes no run directory: no report.
+  if (!std::filesystem::exists(run.outcome.dir / "report.json")) return run;
   std::ifstream in(run.outcome.dir / "report.json");
   run.report = nlohmann::json::parse(in);
   write_file_atomic(out / "reports" / (name + ".json"), run.report.dump(1) + "\n");
@@ -170,6 +172,21 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
     const bool cut = run.cut;
     const double seconds = run.seconds;
     const nlohmann::json* worst = nullptr;
+    if (report.is_null()) {  // cut before its first evaluation: a failure with nothing measured
+      ++rows;
+      ClassTally& c = tally[kind];
+      ++c.scenes;
+      c.evaluations.push_back(0);
+      c.seconds.push_back(seconds);
+      c.cpu_seconds.push_back(run.cpu_seconds);
+      all_seconds.push_back(seconds);
+      all_cpu.push_back(run.cpu_seconds);
+      t.add({name, kind, std::to_string(r.keyframes), r.friction ? "yes" : "no", r.thrown ? "yes" : "no",
+             r.character ? "yes" : "no", r.scene.at("controls").at("kind").get<std::string>(), "", "", "", "", "0",
+             fmt(seconds), fmt(run.cpu_seconds), run.load, "cut before its first evaluation", "no"});
+      t.write(out / "reachable.csv");
+      continue;
+    }
     for (const auto& k : report.at("keyframe_errors"))
       if (k.at("judged").get<bool>() &&
           (!worst || k.at("miss_after").get<double>() > worst->at("miss_after").get<double>()))

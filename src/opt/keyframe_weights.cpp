@@ -1,16 +1,18 @@
 #include "opt/keyframe_weights.h"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 namespace kf {
 
 std::vector<double> raised_weight_scales(const std::vector<double>& scales, const std::vector<bool>& unmet,
-                                         const KeyframeWeightRule& rule) {
+                                         const KeyframeWeightRule& rule, int round) {
+  const double factor = std::pow(rule.factor, round);
   std::vector<double> out(unmet.size(), 1.0);
   for (size_t k = 0; k < unmet.size(); ++k) {
     if (k < scales.size()) out[k] = scales[k];
-    if (unmet[k]) out[k] *= rule.factor;
+    if (unmet[k]) out[k] *= factor;
   }
   return out;
 }

@@ -298,7 +298,7 @@ void press_missed_keyframes(Run& run, std::vector<StageSpec>& stages) {
     const double before = scene_keyframe_terms(problem);
     std::vector<std::string> names;
     for (const auto& term : problem.breakdown()) names.push_back(term.first);
-    run.weight_scales = raised_weight_scales(problem.weight_scales(), unmet, rule);
+    run.weight_scales = raised_weight_scales(problem.weight_scales(), unmet, rule, round + 1);
     run.log.say(describe_raise(names, run.weight_scales, unmet) + " with " + std::to_string(left) + " evaluations");
     const VecX z_before = r.z;
     const StepSchedule schedule_before = r.schedule;
@@ -308,7 +308,7 @@ void press_missed_keyframes(Run& run, std::vector<StageSpec>& stages) {
     if (r.interrupted) return;
     r.problem->evaluate(r.z, nullptr);
     const double after = scene_keyframe_terms(*r.problem);
-    if (after <= rule.keep_below * before) continue;
+    if (after < rule.keep_below * before) continue;
     std::ostringstream os;
     os << std::scientific << std::setprecision(3) << "the raised weights took the keyframe terms from " << before
        << " to " << after << ": the point before them is kept";
