@@ -4,6 +4,9 @@
   tablecloth.obj   a round tablecloth: a disc of radius 0.6 m in rings of triangles, Y up, centred on the origin
   swallowtail.obj  a 1.2 m x 0.72 m flag of 20 x 12 vertices (quads) with a V cut 0.3 m deep into its fly end,
                    in the x-y plane, hoist edge on x = 0
+  poncho.obj       a 0.8 m x 1.0 m poncho (x across the shoulders, z front to back) of 0.05 m quads, lying flat
+                   in the x-z plane (Y up) centred on the origin, with a neck hole: the quads whose centre lies
+                   within 0.12 m of the origin are left out
 
 Usage: scripts/make_cloth_meshes.py [out-dir]   (default assets/cloth)
 """
@@ -73,11 +76,34 @@ def swallowtail(nx=20, ny=12, width=1.2, height=0.72, cut=0.3):
     return vertices, [tuple(index[v] for v in f) for f in faces]
 
 
+def poncho(width=0.8, length=1.0, spacing=0.05, hole=0.12):
+    nx, nz = round(width / spacing) + 1, round(length / spacing) + 1
+    x0, z0 = -width / 2, -length / 2
+    faces, used = [], set()
+    for k in range(nz - 1):
+        for i in range(nx - 1):
+            cx, cz = x0 + (i + 0.5) * spacing, z0 + (k + 0.5) * spacing
+            if math.hypot(cx, cz) < hole:
+                continue
+            # (x, z) -> (x, z + dz) -> (x + dx, z + dz): counter-clockwise seen from +Y (the normal points up).
+            q = (k * nx + i, (k + 1) * nx + i, (k + 1) * nx + i + 1, k * nx + i + 1)
+            faces.append(q)
+            used.update(q)
+    index, vertices = {}, []
+    for k in range(nz):
+        for i in range(nx):
+            if k * nx + i in used:
+                index[k * nx + i] = len(vertices)
+                vertices.append((x0 + i * spacing, 0.0, z0 + k * spacing))
+    return vertices, [tuple(index[v] for v in f) for f in faces]
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "assets", "cloth")
     os.makedirs(out, exist_ok=True)
     write_obj(os.path.join(out, "tablecloth.obj"), "Tablecloth", *tablecloth())
     write_obj(os.path.join(out, "swallowtail.obj"), "Swallowtail", *swallowtail())
+    write_obj(os.path.join(out, "poncho.obj"), "Poncho", *poncho())
 
 
 if __name__ == "__main__":

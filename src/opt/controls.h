@@ -1,18 +1,16 @@
 #pragma once
-// How the optimisation variables z become control forces: one force per particle per step (paper),
-// one per particle per frame held over its substeps (Stuyck ch. 8), the initial velocities only, one
-// initial linear and angular velocity for the whole body (a thrown sheet needs six numbers, not 3p), or
-// initial velocities interpolated from a 3 x 3 lattice laid over the sheet (smooth: they bend the throw
-// without exciting the stiff springs between neighbours, which per-particle velocities do), or per-frame
-// forces interpolated from the same lattice (a coarse stage before per-particle forces: its directions move
-// the sheet as a whole, where a per-particle gradient in contact is ruled by the few particles touching).
-// Ground-bound (planar) systems get no y components.
-#include <array>
-#include <utility>
+// How the optimisation variables z become control forces or initial velocities. A kind is a timing (the
+// initial velocities; one force per step, as in the paper; one per frame held over its substeps, Stuyck
+// ch. 8) and a basis (control_basis.h: per particle; a 3 x 3 lattice laid over the sheet, smooth, so it
+// bends a throw or moves a sheet in contact as a whole without exciting the stiff springs between
+// neighbours; a rigid linear and angular velocity, six numbers for a thrown sheet instead of 3p). The
+// timing is decided here, each basis in its own struct. Ground-bound (planar) systems get no y components.
+#include <variant>
 #include <vector>
 
 #include "core/types.h"
-#include "scene/objective_spec.h"
+#include "opt/control_basis.h"
+#include "scene/control_kind.h"
 #include "scene/time_spec.h"
 
 namespace kf {
@@ -23,17 +21,17 @@ class Controls {
   Controls(const ControlSpec& spec, const TimeSpec& time, int particles, bool planar, const VecX& x0_scene,
            const VecX& v0_scene);
 
-  int size() const { return rigid_ ? 6 : blocks_ * block_size(); }
+  int size() const { return blocks_ * block_size(); }
+  // The two axes of the kind (scene/objective_spec.h).
+  ControlTiming timing() const { return timing_; }
+  ControlBasis basis() const { return control_basis(kind_); }
   // Force controls (per step, per frame, per frame on the lattice), not initial velocities.
-  bool forces() const { return kind_ != ControlKind::kInitialVelocity; }
+  bool forces() const { return timing_ != ControlTiming::kInitial; }
   // The scene's kind (its name: kind_name(), for logs and reports).
-  ControlKind kind() const { return name_; }
-  const char* kind_name() const { return control_kind_name(name_); }
+  ControlKind kind() const { return kind_; }
+  const char* kind_name() const { return control_kind_name(kind_); }
   // Initial velocities (per particle, rigid or on the lattice), not forces over time.
-  bool initial() const {
-    return name_ == ControlKind::kInitialVelocity || name_ == ControlKind::kInitialRigidVelocity ||
-           name_ == ControlKind::kInitialLatticeVelocity;
-  }
+  bool initial() const { return timing_ == ControlTiming::kInitial; }
   // The starting point of the optimisation: no force, or the scene's initial velocities.
   VecX initial_guess() const;
   // z (size()) -> initial velocities v0 (3p) and per-step forces U (N entries of 3p, resized here).
@@ -57,7 +55,7 @@ class Controls {
   void force_at(const VecX& z, int n, VecX& u) const;
   void add_step_gradient(int n, const VecX& uhat, VecX& dz) const;
   // The first step whose force is a control (0 for initial-velocity controls, which need the whole adjoint).
-  int first_step() const { return kind_ == ControlKind::kInitialVelocity ? 0 : first_step_; }
+  int first_step() const { return first_step_; }
   // The initial velocities z gives (3p).
   void initial_velocity(const VecX& z, VecX& v0) const;
   // The initial-velocity controls (size()) that give v0 (3p), e.g. a rigid throw's velocities carried into
@@ -70,36 +68,32 @@ class Controls {
   double effort(const VecX& z, VecX& dz) const;
 
  private:
-  ControlKind name_, kind_;  // the scene's kind; how it behaves (rigid is a kind of initial_velocity, lattice
-                             // forces of per_frame)
+  ControlKind kind_;  // the scene's
+  ControlTiming timing_;
+  std::vector<int> comps_;  // which of x, y, z are controlled
+  AnyControlBasis basis_;  // what one block sets (control_basis.h)
   double alpha_;
   int steps_, substeps_, frames_, particles_, blocks_;
   double h_;
-  int first_step_ = 0;       // the first step with a force (controls' from_frame)
-  std::vector<int> comps_;  // which of x, y, z are controlled
+  int first_step_ = 0;  // the first step with a force (controls' from_frame; 0 for initial velocities)
+  VecX v0_scene_;
   // The force block step n reads (-1: before first_step_, no force).
   int block_of(int n) const;
-  // Variables per block: one per node of the lattice or per particle, times the controlled components.
-  int block_size() const { return (lattice_ ? kLatticeNodes : particles_) * int(comps_.size()); }
-  // One block's values per particle (3p, controlled components only; others untouched) and the chain rule
-  // back (added into the block).
-  void spread(const double* block, VecX& per_particle) const;
-  void collect(const VecX& per_particle, double* block) const;
-  // The block that spreads closest (least squares) to per-particle values (3p); the lattice only.
-  void fit(const VecX& per_particle, double* block) const;
-  VecX v0_scene_;
-  // Rigid initial velocity: z = (Δv, ω), v0_i = v0_scene_i + Δv + ω × (x0_i − c); arms_ holds x0_i − c.
-  bool rigid_ = false;
-  VecX arms_;
-  void rigid_velocity(const VecX& z, VecX& v0) const;
-  void rigid_gather(const VecX& dv0, VecX& dz) const;
-  // Lattice: v0_i = v0_scene_i + Σ_k w_ik z_k (or a frame's force u_i = Σ_k w_ik z_k), bilinear over the
-  // kLatticeSide² nodes of a grid spanning the initial sheet's two widest principal axes; each particle's
-  // four (node, weight).
-  static constexpr int kLatticeSide = 3, kLatticeNodes = kLatticeSide * kLatticeSide;
-  bool lattice_ = false;
-  std::vector<std::array<std::pair<int, double>, 4>> lattice_weights_;
-  void lay_lattice(const VecX& x0_scene);
+  int block_size() const {
+    return std::visit([](const auto& b) { return b.size(); }, basis_);
+  }
+  // One block's values per particle (added into 3p) and the chain rule back (added into the block).
+  void spread(const double* block, VecX& per_particle) const {
+    std::visit([&](const auto& b) { b.spread(block, per_particle); }, basis_);
+  }
+  void collect(const VecX& per_particle, double* block) const {
+    std::visit([&](const auto& b) { b.collect(per_particle, block); }, basis_);
+  }
+  void fit(const VecX& per_particle, double* block) const {
+    std::visit([&](const auto& b) { b.fit(per_particle, block); }, basis_);
+  }
+  // Per-particle initial velocities are the velocities themselves; lattice and rigid ones change the scene's.
+  bool per_particle() const { return std::holds_alternative<ParticleBasis>(basis_); }
 };
 
 }  // namespace kf

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <array>
-#include <assimp/Importer.hpp>
 #include <cctype>
 #include <cmath>
 #include <fstream>
@@ -13,6 +12,8 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/file_name.h"
+#include "core/mesh_import.h"
 
 namespace kf {
 
@@ -134,25 +135,27 @@ ClothMesh read_obj(const std::filesystem::path& path, const std::string& name) {
   return compacted(file, vertices, std::move(faces));
 }
 
-// Any other format, through assimp: the named mesh (or the only one), corners at equal positions welded
-// (an exporter splits a vertex where its normals or texture coordinates differ).
+// Any other format, through assimp in a child process (core/mesh_import.h: its crashes, non-regular or
+// oversized referenced files and non-finite vertices are InputErrors naming the file): the named mesh (or
+// the only one), corners at equal positions welded (an exporter splits a vertex where its normals or
+// texture coordinates differ).
 ClothMesh read_with_assimp(const std::filesystem::path& path, const std::string& name) {
-  const std::string file = path.string();
-  Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFile(file, aiProcess_JoinIdenticalVertices);
-  if (!scene || !scene->mRootNode) throw InputError(file + ": cannot read the cloth mesh: " + importer.GetErrorString());
+  const std::string file = printable(path.string());
+  MeshImportOptions options;
+  options.steps = aiProcess_JoinIdenticalVertices;
+  const std::unique_ptr<aiScene> scene = import_mesh_file(path, options);
   std::vector<const aiMesh*> matches;
   std::string list;
   for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
     const aiMesh* m = scene->mMeshes[k];
     if (!(m->mPrimitiveTypes & (aiPrimitiveType_TRIANGLE | aiPrimitiveType_POLYGON))) continue;
     const std::string n = m->mName.C_Str();
-    list += (list.empty() ? "" : ", ") + ("\"" + n + "\"");
+    list += (list.empty() ? "" : ", ") + ("\"" + printable(n) + "\"");
     if (name.empty() || n == name) matches.push_back(m);
   }
   if (matches.size() != 1) {
     const std::string what = name.empty() ? "expected one mesh with faces or cloth.mesh.name"
-                                          : "no mesh named \"" + name + "\"";
+                                          : "no mesh named \"" + printable(name) + "\"";
     throw InputError(file + ": " + what + " (the file has " + (list.empty() ? std::string("none") : list) + ")");
   }
   const aiMesh* m = matches[0];

@@ -23,7 +23,12 @@ std::shared_ptr<const ClothMesh> parse_cloth_mesh(Block b, const std::filesystem
   }
   const Vec3 offset = b.vec3("offset", Vec3::Zero());
   const std::filesystem::path path = directory / file;
-  auto mesh = std::make_shared<ClothMesh>(read_cloth_mesh(path, name));
+  std::shared_ptr<ClothMesh> mesh;
+  try {
+    mesh = std::make_shared<ClothMesh>(read_cloth_mesh(path, name));
+  } catch (const InputError& e) {
+    b.fail("file", e.what());  // the scene's file and field before the mesh file's own message
+  }
   const Mat3 R = rotation.toRotationMatrix();
   for (Vec3& p : mesh->vertices) {
     if (z_up) p = Vec3(p.x(), p.z(), -p.y());

@@ -13,7 +13,7 @@ namespace {
 Vec3 layout_position(const ClothSpec& c, int particle) { return cloth_rest_position(c, particle); }
 
 // A pinned particle's own target this close to it (metres) is where the pin holds it: targets are written
-// rounded (shapes.json's to 0.1 mm).
+// rounded (to a tenth of a millimetre, say).
 constexpr double kPinnedTargetSlack = 1e-3;
 
 // The pin that most limits a particle at rest position `rest` from reaching `target`: the largest ratio of

@@ -10,6 +10,7 @@
 #include "core/ground_region.h"
 #include "core/json_depth.h"
 #include "scene/cloth_mesh_spec.h"
+#include "scene/control_kind.h"
 #include "scene/params.h"
 #include "scene/particle_selector.h"
 #include "scene/svg_shape_spec.h"
@@ -252,11 +253,9 @@ ControlSpec parse_controls(Block b, ControlsBlock where, int frames, const Contr
   const std::string kind = b.string("kind", control_kind_name(c.kind), names);
   for (ControlKind k : kinds)
     if (kind == control_kind_name(k)) c.kind = k;
-  // Initial velocities are one control per particle, summed in the effort: at forces' 1e-4 the effort of a
-  // throw outweighs a centimetre of keyframe error on a 12 x 12 sheet (throw-over-bar.json stopped 1.24 cm
-  // away with the effort 99 % of its objective).
-  const bool initial = c.kind == ControlKind::kInitialVelocity || c.kind == ControlKind::kInitialRigidVelocity ||
-                       c.kind == ControlKind::kInitialLatticeVelocity;
+  // Initial velocities are one control per particle, summed in the effort: at forces' weight the effort of a
+  // throw outweighs centimetres of keyframe error on a small sheet, so they get a smaller default.
+  const bool initial = control_timing(c.kind) == ControlTiming::kInitial;
   c.alpha = b.number("alpha", where == ControlsBlock::kForceStage ? c.alpha : initial ? kInitialVelocityAlpha : 1e-4,
                      0.0, 1e6);
   if (where != ControlsBlock::kInitialStage) c.from_frame = b.integer("from_frame", c.from_frame, 0, std::max(0, frames - 1));

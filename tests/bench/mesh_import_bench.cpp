@@ -1,4 +1,4 @@
-// What reading an untrusted mesh in a child process costs (sim/mesh_import.h): the character files' import
+// What reading an untrusted mesh in a child process costs (core/mesh_import.h): the character files' import
 // through assimp in this process against the same import in a forked child that sends the scene back
 // through a pipe, with the steps and checks Character and `inspect` use. Arg 0: the body of the cape scenes
 // (assets/character/BCN_Epileptic.X), 1: Debian's Testwuson.X; arg 1: isolated (1) or in process (0).
@@ -10,7 +10,7 @@
 
 #include <filesystem>
 
-#include "sim/mesh_import.h"
+#include "core/mesh_import.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// libFuzzer target for mesh files through the isolated reader (sim/mesh_import.h): any bytes, under any of a
+// libFuzzer target for mesh files through the isolated reader (core/mesh_import.h): any bytes, under any of a
 // few file extensions (which pick assimp's importer), either give a scene whose every index is in range and
 // every number finite, or an InputError. assimp's own crashes end its child process and become that
 // InputError; a crash, leak or hang of this process is a finding.
@@ -14,7 +14,7 @@
 #include <string>
 
 #include "core/error.h"
-#include "sim/mesh_import.h"
+#include "core/mesh_import.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   namespace fs = std::filesystem;

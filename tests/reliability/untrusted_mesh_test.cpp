@@ -3,6 +3,8 @@
 // (and, in a scene, the field), and write nothing.
 #include <sys/stat.h>
 
+#include <limits>
+
 #include "cli_harness.h"
 
 namespace kf::reliability {
@@ -83,6 +85,21 @@ TEST_F(UntrustedMesh, CsmWithLargeFrameNumbersThatCorruptsTheHeapIsExit3) {
 TEST_F(UntrustedMesh, ObjWithANanVertexIsRefused) {
   write("nan.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   expect_refused((dir_ / "nan.obj").string(), "mesh 0 'defaultobject': vertex 0 is not finite");
+}
+
+// assimp's JoinIdenticalVertices welds a NaN vertex into another one: the values are checked as read.
+TEST_F(UntrustedMesh, GltfWithANanVertexIsRefusedBeforeItsVerticesAreWelded) {
+  const float v[9] = {0, 0, 0, 1, 0, 0, 0, std::numeric_limits<float>::quiet_NaN(), 1};
+  write("buffer.bin", std::string(reinterpret_cast<const char*>(v), sizeof v));
+  write("nan.gltf", R"({"asset": {"version": "2.0"}, "buffers": [{"uri": "buffer.bin", "byteLength": 36}],
+    "bufferViews": [{"buffer": 0, "byteLength": 36}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                   "min": [0, 0, 0], "max": [1, 1, 0]}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+    "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0})");
+  const CliResult r = run_bounded("inspect nan.gltf", dir_);
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_EQ(r.output, "keyframe: error: nan.gltf: mesh 0 'meshes[0]': vertex 2 is not finite\n");
 }
 
 TEST_F(UntrustedMesh, GltfWhoseBufferIsAFifoIsRefusedWithoutHanging) {

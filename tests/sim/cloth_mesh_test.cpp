@@ -4,12 +4,15 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 
 #include "app/run_dir.h"
 #include "core/error.h"
 #include "opt/problem.h"
+#include "scene/cloth_mesh.h"
 #include "scene/cloth_mesh_spec.h"
 #include "sim/cloth/cloth_springs.h"
 #include "sim/cloth/cloth_terms.h"
@@ -78,6 +81,47 @@ TEST(ClothMesh, AGridWrittenAsQuadsGetsTheGridsSpringsInTheGridsOrder) {
 }
 
 // Bending across every interior edge: a triangle pair's opposite corners; none across a boundary edge.
+// The irregular patch written as ASCII PLY is read by assimp in a child process (core/mesh_import.h): the
+// same vertices (to float precision, assimp's) and the same faces, its quads kept as quads.
+TEST(ClothMesh, APlyReadThroughTheChildKeepsItsQuads) {
+  test::MeshDir dir;
+  const ClothMesh obj = read_cloth_mesh(test::write_irregular_obj(dir.path(), Vec3::Zero(), 1.0), "");
+  const auto ply = dir.path() / "irregular.ply";
+  {
+    std::ofstream out(ply);
+    out << "ply\nformat ascii 1.0\nelement vertex " << obj.vertices.size()
+        << "\nproperty double x\nproperty double y\nproperty double z\nelement face " << obj.faces.size()
+        << "\nproperty list uchar int vertex_indices\nend_header\n";
+    out.precision(17);
+    for (const Vec3& p : obj.vertices) out << p.x() << " " << p.y() << " " << p.z() << "\n";
+    for (const auto& f : obj.faces) {
+      out << f.size();
+      for (int v : f) out << " " << v;
+      out << "\n";
+    }
+  }
+  const ClothMesh m = read_cloth_mesh(ply, "");
+  ASSERT_EQ(m.vertices.size(), obj.vertices.size());
+  ASSERT_EQ(m.faces.size(), obj.faces.size());
+  // Each face as its corners' positions, in order from its lowest corner: the same list for both files.
+  auto faces_by_position = [](const ClothMesh& c) {
+    std::vector<std::vector<std::array<long, 3>>> out;
+    for (const auto& f : c.faces) {
+      std::vector<std::array<long, 3>> corners;
+      for (int v : f) {
+        const Vec3 p = c.vertices[size_t(v)] * 1e5;
+        corners.push_back({std::lround(p.x()), std::lround(p.y()), std::lround(p.z())});
+      }
+      std::rotate(corners.begin(), std::min_element(corners.begin(), corners.end()), corners.end());
+      out.push_back(corners);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  EXPECT_EQ(faces_by_position(m), faces_by_position(obj));
+  EXPECT_GT(std::count_if(m.faces.begin(), m.faces.end(), [](const auto& f) { return f.size() == 4; }), 10);
+}
+
 TEST(ClothMesh, TrianglePairsGetOneBendingSpringAcrossTheirSharedEdge) {
   test::MeshDir dir;
   const auto file = dir.path() / "pair.obj";

@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "core/warnings.h"
 #include "sim/cape/anchor_track.h"
+#include "sim/cape/skin_pin_track.h"
 #include "sim/character/cape_anchors.h"
 #include "sim/character/scene_character.h"
 #include "sim/make_system.h"
@@ -16,8 +17,8 @@ namespace kf {
 namespace {
 
 // The cloth block lays the sheet out flat; its pinned edge then jumps to the anchors in the first step.
-// More than 10 cm is almost always a cloth block that does not match the character (the shipped capes start
-// 8 cm behind theirs, off the back).
+// More than 10 cm is almost always a cloth block that does not match the character (a cape laid out a few
+// centimetres off its body's back is normal).
 constexpr double kPinJumpWarning = 0.10;  // m
 
 void warn_if_pins_jump(const ClothSpec& c, const std::vector<Vec3>& anchors, const std::vector<double>& params,
@@ -45,34 +46,44 @@ void warn_if_pins_jump(const ClothSpec& c, const std::vector<Vec3>& anchors, con
   warn(msg);
 }
 
-}  // namespace
+// A mesh cape's length for the measures: the largest side of its rest mesh's box.
+double mesh_extent(const ClothMesh& m) {
+  Vec3 lo = m.vertices[0], hi = m.vertices[0];
+  for (const Vec3& v : m.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  return (hi - lo).maxCoeff();
+}
 
+}  // namespace
 
 CapeSystem::CapeSystem(const ClothSpec& cloth, const CharacterSpec& character, double fps, int steps, double h)
     : spec_(character), fps_(fps), h_(h), character_(load_character(character, int(std::lround(steps * h * fps)))),
-      cape_length_(cloth.height) {
-  if (cloth.mesh) throw InputError(cloth.mesh->file + ": a cape on a character is a grid cloth (cloth.mesh is not for capes yet)");
+      cape_length_(cloth.mesh ? mesh_extent(*cloth.mesh) : cloth.height) {
   ClothSpec c = cloth;
-  c.pins = named_pin_set("top_edge", c.nx, c.ny);
   // The moving body does work on the cape that a step's energy check cannot account for, so cape steps
   // are never split (its scenes use small steps).
   c.max_halvings = 0;
-  std::vector<double> params;
-  for (int k = 0; k < int(c.pins.size()); ++k) params.push_back(c.nx > 1 ? double(k) / (c.nx - 1) : 0.5);
+  std::unique_ptr<PinTrack> track;
+  if (cloth.mesh) {  // a mesh cloth's own pins follow the skin
+    track = skin_pin_track(character_, character, c, fps, steps, h);
+  } else {
+    c.pins = named_pin_set("top_edge", c.nx, c.ny);
+    std::vector<double> params;
+    for (int k = 0; k < int(c.pins.size()); ++k) params.push_back(c.nx > 1 ? double(k) / (c.nx - 1) : 0.5);
 
-  // The pins' path over the whole run (one pose per step, plus one past the end for the last velocity).
-  const std::vector<int> anchor_ids = cape_anchor_vertices(character_, character.anchors);
-  std::vector<std::vector<Vec3>> anchors;
-  VecX gathered;
-  for (int n = 0; n <= steps + 1; ++n) {
-    pose_at_frame(character_, spec_, n * h_ * fps_, pose_);
-    gather_vertices(pose_, anchor_ids, gathered);
-    std::vector<Vec3> a(anchor_ids.size());
-    for (size_t k = 0; k < a.size(); ++k) a[k] = seg(gathered, int(k));
-    anchors.push_back(std::move(a));
+    // The pins' path over the whole run (one pose per step, plus one past the end for the last velocity).
+    const std::vector<int> anchor_ids = cape_anchor_vertices(character_, character.anchors);
+    std::vector<std::vector<Vec3>> anchors;
+    VecX gathered;
+    for (int n = 0; n <= steps + 1; ++n) {
+      pose_at_frame(character_, spec_, n * h_ * fps_, pose_);
+      gather_vertices(pose_, anchor_ids, gathered);
+      std::vector<Vec3> a(anchor_ids.size());
+      for (size_t k = 0; k < a.size(); ++k) a[k] = seg(gathered, int(k));
+      anchors.push_back(std::move(a));
+    }
+    track = std::make_unique<AnchorTrack>(anchors, c.pins, params, c.particles(), h);
+    if (character.start_x.size() == 0) warn_if_pins_jump(c, anchors[0], params, character.where);
   }
-  auto track = std::make_unique<AnchorTrack>(anchors, c.pins, params, c.particles(), h);
-  if (character.start_x.size() == 0) warn_if_pins_jump(c, anchors[0], params, character.where);
 
   std::vector<std::unique_ptr<Collider>> extra;
   auto body = std::make_unique<BodyCollider>(character_.triangles(), character_.vertex_count(),

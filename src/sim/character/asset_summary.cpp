@@ -12,7 +12,7 @@
 
 #include "core/error.h"
 #include "core/file_name.h"
-#include "sim/mesh_import.h"
+#include "core/mesh_import.h"
 #include "sim/character/character.h"
 
 namespace kf {

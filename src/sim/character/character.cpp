@@ -10,7 +10,7 @@
 
 #include "core/error.h"
 #include "core/file_name.h"
-#include "sim/mesh_import.h"
+#include "core/mesh_import.h"
 
 namespace kf {
 namespace {

@@ -18,7 +18,7 @@ namespace kf {
 // Grain sizes: below these a parallel loop costs more than it saves on two cores. Loops over particles
 // use TBB's static partitioner, as the PCG's do, so each thread gets the same particles in every loop and
 // their data stays in its core's cache: with TBB's default partitioner some processes ran the 50 x 50 step
-// on two threads 40 % slower than others. Loops over springs do not: springs are ordered by kind, so a
+// on two threads markedly slower than others. Loops over springs do not: springs are ordered by kind, so a
 // static share of them spans the whole sheet (measured slower).
 inline constexpr int kClothSpringGrain = 1024;
 inline constexpr int kClothParticleGrain = 256;

@@ -11,7 +11,7 @@ namespace kf {
 namespace {
 
 constexpr double kOmega = 0.8;    // Jacobi damping: below 2 / rho(D^-1 A) (about 2 for these stencils); 0.8
-                                  // takes 9 % fewer CG iterations than 0.6 from 32^2 to 128^2
+                                  // took fewer CG iterations than 0.6 from 32^2 to 128^2
 constexpr int kSweeps = 1;        // smoothing sweeps before and after the coarse correction (V(1,1):
                                   // fewer block products per CG iteration than V(2,2) for the same time)
 constexpr int kCoarsest = 64;     // a level with at most this many nodes is solved exactly

@@ -1,9 +1,10 @@
-#include "sim/mesh_wire.h"
+#include "core/mesh_wire.h"
 
 #include <assimp/scene.h>
 
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <type_traits>
 #include <vector>
 
@@ -78,21 +79,23 @@ void put_keys(Writer& w, const K* keys, unsigned n) {
 
 template <class K>
 K* get_keys(Reader& r, unsigned& n) {
-  n = r.count(sizeof(K));
-  K* keys = n ? new K[n] : nullptr;
-  for (unsigned k = 0; k < n; ++k) keys[k] = r.get<K>();
-  return keys;
+  const unsigned count = r.count(sizeof(K));
+  std::unique_ptr<K[]> keys(count ? new K[count] : nullptr);  // freed if the bytes are cut short
+  for (unsigned k = 0; k < count; ++k) keys[k] = r.get<K>();
+  n = count;
+  return keys.release();
 }
 
 void put_mesh(Writer& w, const aiMesh& m) {
   w.put_string(m.mName);
   w.put(static_cast<uint32_t>(m.mNumVertices));
   for (unsigned v = 0; v < m.mNumVertices; ++v) w.put(m.mVertices[v]);
-  std::vector<uint32_t> triangles;
+  w.put(static_cast<uint32_t>(m.mPrimitiveTypes));
+  std::vector<const aiFace*> faces;
   for (unsigned f = 0; f < m.mNumFaces; ++f)
-    if (m.mFaces[f].mNumIndices == 3) triangles.insert(triangles.end(), m.mFaces[f].mIndices, m.mFaces[f].mIndices + 3);
-  w.put(static_cast<uint32_t>(triangles.size() / 3));
-  for (uint32_t i : triangles) w.put(i);
+    if (m.mFaces[f].mNumIndices >= 3) faces.push_back(&m.mFaces[f]);
+  w.put(static_cast<uint32_t>(faces.size()));
+  for (const aiFace* f : faces) put_keys(w, f->mIndices, f->mNumIndices);
   w.put(static_cast<uint32_t>(m.mNumBones));
   for (unsigned b = 0; b < m.mNumBones; ++b) {
     const aiBone& bone = *m.mBones[b];
@@ -105,18 +108,18 @@ void put_mesh(Writer& w, const aiMesh& m) {
 aiMesh* get_mesh(Reader& r) {
   auto m = std::make_unique<aiMesh>();
   r.get_string(m->mName);
-  m->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
   m->mNumVertices = r.count(sizeof(aiVector3D));
   m->mVertices = new aiVector3D[m->mNumVertices];
   for (unsigned v = 0; v < m->mNumVertices; ++v) m->mVertices[v] = r.get<aiVector3D>();
-  m->mNumFaces = r.count(3 * sizeof(uint32_t));
+  m->mPrimitiveTypes = r.get<uint32_t>();
+  m->mNumFaces = r.count(4 * sizeof(uint32_t));  // a count and at least three corners each
   m->mFaces = new aiFace[m->mNumFaces];
   for (unsigned f = 0; f < m->mNumFaces; ++f) {
     aiFace& face = m->mFaces[f];
-    face.mNumIndices = 3;
-    face.mIndices = new unsigned[3];
-    for (int k = 0; k < 3; ++k)
-      if ((face.mIndices[k] = r.get<uint32_t>()) >= m->mNumVertices) throw MeshWireError("face index out of range");
+    face.mIndices = get_keys<unsigned>(r, face.mNumIndices);
+    if (face.mNumIndices < 3) throw MeshWireError("face of fewer than 3 corners");
+    for (unsigned k = 0; k < face.mNumIndices; ++k)
+      if (face.mIndices[k] >= m->mNumVertices) throw MeshWireError("face index out of range");
   }
   const unsigned bones = r.count(sizeof(uint64_t) + sizeof(aiMatrix4x4) + sizeof(uint32_t));
   m->mBones = bones ? new aiBone*[bones]() : nullptr;

@@ -1,4 +1,4 @@
-#include "sim/mesh_import.h"
+#include "core/mesh_import.h"
 
 #include <assimp/DefaultIOSystem.h>
 #include <assimp/scene.h>
@@ -17,7 +17,7 @@
 
 #include "core/error.h"
 #include "core/file_name.h"
-#include "sim/mesh_wire.h"
+#include "core/mesh_wire.h"
 
 // Present only under a sanitizer: the child clears it so that its crash is not reported as the parent's
 // (a fuzzer's death callback would save the input as a finding of the parent).
@@ -52,6 +52,55 @@ class RegularFilesOnly : public Assimp::DefaultIOSystem {
   std::string refused;
 };
 
+bool finite(const aiVector3D& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const aiQuaternion& q) { return finite(aiVector3D(q.x, q.y, q.z)) && std::isfinite(q.w); }
+bool finite(const aiMatrix4x4& m) {
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c)
+      if (!std::isfinite(m[r][c])) return false;
+  return true;
+}
+template <class K>
+bool finite(const K* keys, unsigned n) {
+  for (unsigned k = 0; k < n; ++k)
+    if (!std::isfinite(keys[k].mTime) || !finite(keys[k].mValue)) return false;
+  return true;
+}
+
+std::string quoted(const aiString& s) { return "'" + printable(s.C_Str()) + "'"; }
+
+// Empty when every number keyframe reads from the scene is finite; otherwise the first that is not.
+std::string non_finite_value(const aiScene& scene) {
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh& mesh = *scene.mMeshes[m];
+    for (unsigned v = 0; v < mesh.mNumVertices; ++v)
+      if (!finite(mesh.mVertices[v]))
+        return "mesh " + std::to_string(m) + " " + quoted(mesh.mName) + ": vertex " + std::to_string(v) +
+               " is not finite";
+    for (unsigned b = 0; b < mesh.mNumBones; ++b)
+      if (!finite(mesh.mBones[b]->mOffsetMatrix)) return "bone " + quoted(mesh.mBones[b]->mName) + ": offset matrix is not finite";
+  }
+  std::vector<const aiNode*> nodes = {scene.mRootNode};
+  while (!nodes.empty()) {
+    const aiNode* n = nodes.back();
+    nodes.pop_back();
+    if (!finite(n->mTransformation)) return "node " + quoted(n->mName) + ": transform is not finite";
+    nodes.insert(nodes.end(), n->mChildren, n->mChildren + n->mNumChildren);
+  }
+  for (unsigned a = 0; a < scene.mNumAnimations; ++a) {
+    const aiAnimation& anim = *scene.mAnimations[a];
+    if (!std::isfinite(anim.mDuration) || !std::isfinite(anim.mTicksPerSecond))
+      return "animation " + std::to_string(a) + ": duration is not finite";
+    for (unsigned c = 0; c < anim.mNumChannels; ++c) {
+      const aiNodeAnim& ch = *anim.mChannels[c];
+      if (!finite(ch.mPositionKeys, ch.mNumPositionKeys) || !finite(ch.mRotationKeys, ch.mNumRotationKeys) ||
+          !finite(ch.mScalingKeys, ch.mNumScalingKeys))
+        return "animation " + std::to_string(a) + ", channel " + quoted(ch.mNodeName) + ": a key is not finite";
+    }
+  }
+  return "";
+}
+
 // 'S' and the scene's bytes, or 'E' and why assimp did not read it.
 std::string import_to_bytes(const std::string& name, const MeshImportOptions& options,
                             std::unique_ptr<aiScene>* keep = nullptr) {
@@ -59,7 +108,13 @@ std::string import_to_bytes(const std::string& name, const MeshImportOptions& op
   auto* io = new RegularFilesOnly;  // owned by the importer
   importer.SetIOHandler(io);
   importer.SetPropertyInteger(AI_CONFIG_PP_LBW_MAX_WEIGHTS, options.max_bone_weights);
-  const aiScene* scene = importer.ReadFile(name, options.steps);
+  const aiScene* scene = importer.ReadFile(name, 0);
+  if (!io->refused.empty()) return "E" + io->refused;
+  if (!scene || !scene->mRootNode) return std::string("Ecannot read it: ") + importer.GetErrorString();
+  // Checked as read: post-processing can hide a non-finite value (JoinIdenticalVertices welds a NaN vertex
+  // into another one).
+  if (const std::string problem = non_finite_value(*scene); !problem.empty()) return "E" + problem;
+  if (options.steps) scene = importer.ApplyPostProcessing(options.steps);
   if (!io->refused.empty()) return "E" + io->refused;
   if (!scene || !scene->mRootNode) return std::string("Ecannot read it: ") + importer.GetErrorString();
   if (keep) {
@@ -143,55 +198,6 @@ std::string import_in_child(const std::string& name, const MeshImportOptions& op
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || bytes.empty())
     throw InputError(printable(name) + ": " + child_failure(status, options.seconds));
   return bytes;
-}
-
-bool finite(const aiVector3D& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-bool finite(const aiQuaternion& q) { return finite(aiVector3D(q.x, q.y, q.z)) && std::isfinite(q.w); }
-bool finite(const aiMatrix4x4& m) {
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c)
-      if (!std::isfinite(m[r][c])) return false;
-  return true;
-}
-template <class K>
-bool finite(const K* keys, unsigned n) {
-  for (unsigned k = 0; k < n; ++k)
-    if (!std::isfinite(keys[k].mTime) || !finite(keys[k].mValue)) return false;
-  return true;
-}
-
-std::string quoted(const aiString& s) { return "'" + printable(s.C_Str()) + "'"; }
-
-// Empty when every number keyframe reads from the scene is finite; otherwise the first that is not.
-std::string non_finite_value(const aiScene& scene) {
-  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
-    const aiMesh& mesh = *scene.mMeshes[m];
-    for (unsigned v = 0; v < mesh.mNumVertices; ++v)
-      if (!finite(mesh.mVertices[v]))
-        return "mesh " + std::to_string(m) + " " + quoted(mesh.mName) + ": vertex " + std::to_string(v) +
-               " is not finite";
-    for (unsigned b = 0; b < mesh.mNumBones; ++b)
-      if (!finite(mesh.mBones[b]->mOffsetMatrix)) return "bone " + quoted(mesh.mBones[b]->mName) + ": offset matrix is not finite";
-  }
-  std::vector<const aiNode*> nodes = {scene.mRootNode};
-  while (!nodes.empty()) {
-    const aiNode* n = nodes.back();
-    nodes.pop_back();
-    if (!finite(n->mTransformation)) return "node " + quoted(n->mName) + ": transform is not finite";
-    nodes.insert(nodes.end(), n->mChildren, n->mChildren + n->mNumChildren);
-  }
-  for (unsigned a = 0; a < scene.mNumAnimations; ++a) {
-    const aiAnimation& anim = *scene.mAnimations[a];
-    if (!std::isfinite(anim.mDuration) || !std::isfinite(anim.mTicksPerSecond))
-      return "animation " + std::to_string(a) + ": duration is not finite";
-    for (unsigned c = 0; c < anim.mNumChannels; ++c) {
-      const aiNodeAnim& ch = *anim.mChannels[c];
-      if (!finite(ch.mPositionKeys, ch.mNumPositionKeys) || !finite(ch.mRotationKeys, ch.mNumRotationKeys) ||
-          !finite(ch.mScalingKeys, ch.mNumScalingKeys))
-        return "animation " + std::to_string(a) + ", channel " + quoted(ch.mNodeName) + ": a key is not finite";
-    }
-  }
-  return "";
 }
 
 }  // namespace

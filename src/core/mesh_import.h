@@ -4,7 +4,9 @@
 // assimp runs in a child process (fork) that sends the scene back through a pipe: its crashes, assertions
 // and hangs end the child, and become one InputError naming the file. Every file the import opens (the
 // file itself, a glTF's buffers, a material's textures) must be a regular file under kMaxMeshFileBytes,
-// and every vertex, node transform, bone offset and animation key must be finite.
+// and every vertex, node transform, bone offset and animation key must be finite (checked as assimp read
+// it, before post-processing, and again on the scene received). In core/ so that the scene layer (a cloth's
+// own mesh, cloth.mesh) and the simulation (characters, `inspect`) read every non-OBJ mesh through it.
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -23,7 +25,7 @@ struct MeshImportOptions {
   unsigned seconds = kMeshImportSeconds;  // the isolated import's time limit
 };
 
-// The scene as assimp read it (faces that are not triangles dropped; see mesh_wire.h), with its
+// The scene as assimp read it (points and lines dropped; see mesh_wire.h), with its
 // AI_SCENE_FLAGS_INCOMPLETE flag as assimp set it. Throws InputError "FILE: ..." when the file is not a
 // regular file under the cap, assimp refuses or crashes on it, it opens another file that is not regular
 // or too large, or it holds a non-finite value.

@@ -15,7 +15,7 @@ struct MeshWireError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Faces that are not triangles are left out; metadata keeps booleans, integers, reals and strings.
+// Faces of fewer than 3 corners (points, lines) are left out, polygons kept; metadata keeps booleans, integers, reals and strings.
 std::string scene_to_bytes(const aiScene& scene);
 
 // A scene owned by the caller, every index checked against its array (faces, bone weights, node meshes,
