@@ -27,6 +27,7 @@ std::vector<int> ClothMesh::triangles() const {
 namespace {
 
 constexpr int kMaxCorners = 1000;
+constexpr size_t kMaxGroups = 1000;  // named sets kept from one file
 
 // The polygon without repeated consecutive corners; fanned into triangles beyond 4 corners (a quad stays a
 // quad: a grid's quads give its shear springs on both diagonals).
@@ -44,8 +45,9 @@ void add_face(std::vector<int> f, std::vector<std::vector<int>>& faces) {
   for (size_t k = 1; k + 1 < g.size(); ++k) faces.push_back({g[0], g[k], g[k + 1]});
 }
 
-// Keeps the vertices the faces use, in their order, and renumbers the faces.
-ClothMesh compacted(const std::string& file, const std::vector<Vec3>& all, std::vector<std::vector<int>> faces) {
+// Keeps the vertices the faces use, in their order, and renumbers the faces and the named sets.
+ClothMesh compacted(const std::string& file, const std::vector<Vec3>& all, std::vector<std::vector<int>> faces,
+                    std::map<std::string, std::vector<int>> groups = {}) {
   std::vector<int> index(all.size(), -1);
   for (const auto& f : faces)
     for (int v : f) index[size_t(v)] = 0;
@@ -59,6 +61,14 @@ ClothMesh compacted(const std::string& file, const std::vector<Vec3>& all, std::
   for (auto& f : faces)
     for (int& v : f) v = index[size_t(v)];
   m.faces = std::move(faces);
+  for (auto& [name, set] : groups) {
+    std::vector<int> kept;
+    for (int v : set)
+      if (index[size_t(v)] >= 0) kept.push_back(index[size_t(v)]);
+    std::sort(kept.begin(), kept.end());
+    kept.erase(std::unique(kept.begin(), kept.end()), kept.end());
+    if (!kept.empty()) m.groups[name] = std::move(kept);
+  }
   return m;
 }
 
@@ -93,6 +103,7 @@ ClothMesh read_obj(const std::filesystem::path& path, const std::string& name) {
   std::vector<Vec3> vertices;
   std::vector<std::vector<int>> faces;
   std::vector<std::string> names;
+  std::map<std::string, std::vector<int>> groups;  // by "o" and "g" name: the vertices of their faces
   std::string object, group, line;
   bool named_found = name.empty();
   long line_no = 0;
@@ -123,7 +134,13 @@ ClothMesh read_obj(const std::filesystem::path& path, const std::string& name) {
       named_found = named_found || wanted;
       std::vector<int> f = read_face_corners(ls, long(vertices.size()), fail);
       if (f.size() < 3) fail("expected a face of at least 3 corners");
-      if (wanted) add_face(std::move(f), faces);
+      if (!wanted) continue;
+      for (const std::string* n : {&object, &group})
+        if (!n->empty() && (groups.count(*n) || groups.size() < kMaxGroups)) {
+          auto& set = groups[*n];
+          set.insert(set.end(), f.begin(), f.end());
+        }
+      add_face(std::move(f), faces);
     }
   }
   if (!named_found) {
@@ -132,7 +149,7 @@ ClothMesh read_obj(const std::filesystem::path& path, const std::string& name) {
     throw InputError(file + ": no object or group named \"" + name + "\" (the file has " +
                      (list.empty() ? std::string("none") : list) + ")");
   }
-  return compacted(file, vertices, std::move(faces));
+  return compacted(file, vertices, std::move(faces), std::move(groups));
 }
 
 // Any other format, through assimp in a child process (core/mesh_import.h: its crashes, non-regular or

@@ -4,6 +4,7 @@
 // i-th vertex of the file that a face of the mesh uses (the order Blender and other modellers show).
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,8 @@ struct ClothMesh {
   std::string file;                      // as the scene resolved it (messages)
   std::vector<Vec3> vertices;            // rest positions, metres, in the scene's frame
   std::vector<std::vector<int>> faces;   // polygons (3 or 4 corners; larger ones are fanned), counter-clockwise
+  // Named vertex sets the file carries (OBJ: each "g" group's and "o" object's faces' vertices), ascending.
+  std::map<std::string, std::vector<int>> groups;
 
   int particles() const { return int(vertices.size()); }
   // The faces as triangles (quads split along their first diagonal), three indices each.

@@ -80,4 +80,19 @@ std::vector<int> particles_in_region(Block& b, const ClothSpec& c) {
   return out;
 }
 
+bool is_group_set(const nlohmann::json& set) { return set.is_object() && set.contains("group"); }
+
+std::vector<int> particles_in_group(Block& b, const ClothSpec& c) {
+  const std::string name = b.string("group");
+  b.finish();
+  if (!c.mesh) b.fail("group", "expected a mesh cloth (cloth.mesh): a grid names no vertex sets");
+  const auto it = c.mesh->groups.find(name);
+  if (it != c.mesh->groups.end()) return it->second;
+  std::string list;
+  for (const auto& [n, set] : c.mesh->groups) list += (list.empty() ? "\"" : ", \"") + n + "\"";
+  b.fail("group", "expected a vertex set " + c.mesh->file + " names (it names " +
+                      (list.empty() ? std::string("none: OBJ's \"g\" and \"o\" lines name them") : list) + "), got \"" +
+                      name + "\"");
+}
+
 }  // namespace kf

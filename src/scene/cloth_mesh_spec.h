@@ -7,6 +7,7 @@
 //            "rotation": {"axis": [0, 1, 0], "degrees": 0},  // then about the origin
 //            "offset": [0, 0, 0]}                   // then moved, metres
 //   a region: {"min": [x, y, z], "max": [x, y, z]}  // the particles whose rest position lies in the box
+//   a named set: {"group": "collar"}                // a mesh cloth's vertices the file names (OBJ "g" or "o")
 #include <filesystem>
 #include <memory>
 #include <vector>
@@ -31,5 +32,11 @@ bool is_rest_box(const nlohmann::json& set);
 
 // The particles (ascending) whose rest position lies in the block's box; at least one, or the block fails.
 std::vector<int> particles_in_region(Block& b, const ClothSpec& c);
+
+// Whether a particle set names one of the mesh file's vertex sets ({"group": NAME}).
+bool is_group_set(const nlohmann::json& set);
+
+// The particles (ascending) of the block's named set; the block fails naming the sets the file has.
+std::vector<int> particles_in_group(Block& b, const ClothSpec& c);
 
 }  // namespace kf

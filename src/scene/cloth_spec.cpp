@@ -128,6 +128,9 @@ ClothSpec parse_cloth_spec(Block& b, const std::filesystem::path& directory) {
   if (b.has("pins") && is_rest_box(b.json().at("pins"))) {
     Block region = b.child("pins");
     s.pins = particles_in_region(region, s);
+  } else if (b.has("pins") && is_group_set(b.json().at("pins"))) {
+    Block group = b.child("pins");
+    s.pins = particles_in_group(group, s);
   } else if (s.mesh && b.has("pins") && b.json().at("pins").is_string()) {
     s.pins = {};
     b.string("pins", "none", {"none"});  // the named edges are a grid's

@@ -224,6 +224,9 @@ ObjectiveSpec parse_objective(Block b, const Scene& s) {
   if (b.has("particles") && s.cloth && is_rest_box(b.json().at("particles"))) {
     Block region = b.child("particles");
     o.particles = particles_in_region(region, *s.cloth);
+  } else if (b.has("particles") && s.cloth && is_group_set(b.json().at("particles"))) {
+    Block group = b.child("particles");
+    o.particles = particles_in_group(group, *s.cloth);
   } else if (b.has("particles")) {
     o.particles = parse_particle_selector(b, "particles", p, s.cloth ? &*s.cloth : nullptr);
   }

@@ -68,15 +68,17 @@ std::string cape_scene(int frames, int n, const std::string& anchors, const std:
 })";
 }
 
-// A cloth from a mesh file with every mesh key, pins and a keyframe's particles by region.
-std::string mesh_cloth_scene(int frames) {
+// A cloth from a mesh file with every mesh key, pins and a keyframe's particles by region, or (`named`) by
+// the file's named vertex set.
+std::string mesh_cloth_scene(int frames, bool named) {
+  const std::string pins = named ? R"({"group": "all"})" : R"({"min": [-1, -1, -1], "max": [0.5, 1, 0.5]})";
+  const std::string particles = named ? R"({"group": "all"})" : R"({"min": [0.5, -1, -1], "max": [2, 1, 2]})";
   return R"({
   "time": {"frames": )" + std::to_string(frames) + R"(},
   "cloth": {"mesh": {"file": "cloth.obj", "scale": 1, "up_axis": "y", "rotation": {"axis": [0, 1, 0], "degrees": 0},
                      "offset": [0, 0, 0]},
-            "mass_by": "area", "pins": {"min": [-1, -1, -1], "max": [0.5, 1, 0.5]}},
-  "objectives": [{"type": "center_of_mass", "frame": 5, "particles": {"min": [0.5, -1, -1], "max": [2, 1, 2]},
-                  "target": [0, 0, 0]}],
+            "mass_by": "area", "pins": )" + pins + R"(},
+  "objectives": [{"type": "center_of_mass", "frame": 5, "particles": )" + particles + R"(, "target": [0, 0, 0]}],
   "controls": {"kind": "per_frame"}
 })";
 }
@@ -87,7 +89,7 @@ std::vector<ParamLog> every_branch_logs(const fs::path& scratch) {
   fs::create_directories(scratch);
   // Parsing only checks that the character's file exists; its meshes and nodes are read when simulating.
   std::ofstream(scratch / "character.x") << "xof 0303txt 0032\n";
-  std::ofstream(scratch / "cloth.obj") << "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 2 3 4\n";
+  std::ofstream(scratch / "cloth.obj") << "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\ng all\nf 1 2 3 4\n";
   std::ofstream(scratch / "shape.svg") << "<svg><path d=\"M 0 0 A 1 1 0 0 1 2 0 Z\"/></svg>\n";
   struct Size {
     int frames, agents, cloth_n;
@@ -108,7 +110,8 @@ std::vector<ParamLog> every_branch_logs(const fs::path& scratch) {
                       "start": {"run": ")" + run + R"(", "frame": 0}, "end_target": {"run": ")" + run +
                        R"(", "frame": 1})"),
         cape_scene(z.frames, z.cloth_n, R"({"mesh": "Torso", "points": [[0, 0, 0], [1, 0, 0]]})", ""),
-        mesh_cloth_scene(z.frames),
+        mesh_cloth_scene(z.frames, false),
+        mesh_cloth_scene(z.frames, true),
     };
     for (const std::string& text : texts) {
       ParamLog log;

@@ -292,13 +292,6 @@ TEST(ClothMeshSpec, PinsAndKeyframeParticlesByRegionOfTheRestShape) {
   for (int i : s.objectives[0].particles) EXPECT_GE(s.cloth->mesh->vertices[size_t(i)].x(), 0.5);
 }
 
-// A run directory's copy of the scene names the mesh file absolutely, so render and export read it there.
-TEST(ClothMeshSpec, ARunsSceneCopyNamesTheMeshFileAbsolutely) {
-  nlohmann::json j = nlohmann::json::parse(R"({"cloth": {"mesh": {"file": "../assets/cloth/flag.obj"}}})");
-  absolutise_scene_paths(j, "/data/shots/scenes");
-  EXPECT_EQ(j["cloth"]["mesh"]["file"], "/data/shots/assets/cloth/flag.obj");
-}
-
 std::string load_error(const std::string& text, const std::filesystem::path& file) {
   try {
     parse_scene(text, file);
@@ -306,6 +299,41 @@ std::string load_error(const std::string& text, const std::filesystem::path& fil
     return e.what();
   }
   return "";
+}
+
+// OBJ's "g" and "o" lines name vertex sets: pins and keyframe particles by name, in the compacted order (a
+// vertex no face uses is left out before them), and an unknown name lists the file's names.
+TEST(ClothMeshSpec, PinsAndKeyframeParticlesByTheFilesNamedGroups) {
+  test::MeshDir dir;
+  // A 3 x 2 strip of two quads with an unused vertex first; the left quad in group "hem", the right in "tip".
+  std::ofstream(dir.path() / "strip.obj") << "v 9 9 9\n"
+                                              "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\n"
+                                              "o Strip\ng hem\nf 2 3 6 5\ng tip\nf 3 4 7 6\n";
+  const std::string text = R"({"cloth": {"mesh": {"file": "strip.obj"}, "pins": {"group": "hem"}},
+      "objectives": [{"type": "center_of_mass", "frame": 1, "particles": {"group": "tip"}, "target": [0, 0, 0]}]})";
+  const Scene s = parse_scene(text, dir.path() / "s.json");
+  ASSERT_EQ(s.cloth->particles(), 6);
+  EXPECT_EQ(s.cloth->pins, (std::vector<int>{0, 1, 3, 4}));
+  EXPECT_EQ(s.objectives[0].particles, (std::vector<int>{1, 2, 4, 5}));
+  EXPECT_EQ(s.cloth->mesh->groups.at("Strip"), (std::vector<int>{0, 1, 2, 3, 4, 5}));
+  std::string bad = text;
+  bad.replace(bad.find(R"("group": "tip")"), 14, R"("group": "tail")");
+  EXPECT_NE(load_error(bad, dir.path() / "s.json")
+                .find("/objectives/0/particles/group: expected a vertex set "),
+            std::string::npos)
+      << load_error(bad, dir.path() / "s.json");
+  EXPECT_NE(load_error(bad, dir.path() / "s.json").find("(it names \"Strip\", \"hem\", \"tip\"), got \"tail\""),
+            std::string::npos);
+  // A grid has no named sets.
+  EXPECT_NE(load_error(R"({"cloth": {"pins": {"group": "hem"}}})", dir.path() / "s.json").find("/cloth/pins/group"),
+            std::string::npos);
+}
+
+// A run directory's copy of the scene names the mesh file absolutely, so render and export read it there.
+TEST(ClothMeshSpec, ARunsSceneCopyNamesTheMeshFileAbsolutely) {
+  nlohmann::json j = nlohmann::json::parse(R"({"cloth": {"mesh": {"file": "../assets/cloth/flag.obj"}}})");
+  absolutise_scene_paths(j, "/data/shots/scenes");
+  EXPECT_EQ(j["cloth"]["mesh"]["file"], "/data/shots/assets/cloth/flag.obj");
 }
 
 TEST(ClothMeshSpec, BadMeshInputIsOneClearErrorNamingTheFileAndField) {
