@@ -73,6 +73,7 @@ Scene job_scene(const fs::path& scene_file, const OptimizeOptions& opt) {
   Scene scene = !opt.resume.empty() ? load_run_scene(opt.resume) : load_scene(scene_file);
   if (!opt.adjoint.empty()) scene.optimizer.adjoint = opt.adjoint;
   if (opt.max_seconds >= 0) scene.optimizer.max_seconds = opt.max_seconds;
+  if (opt.stop_when_reached >= 0) scene.optimizer.stop_when_reached = opt.stop_when_reached > 0;
   for (const std::string& w : unreachable_keyframes(scene)) warn(w);
   return scene;
 }
@@ -116,6 +117,7 @@ StrategyHooks job_hooks(const Scene& scene, const OptimizeOptions& opt, std::uin
     return line;
   };
   h.keyframes_met = [&scene](Problem& problem) { return keyframes_met(scene, problem); };
+  h.keyframes_unmet = [&scene](Problem& problem) { return keyframes_unmet(scene, problem); };
   return h;
 }
 

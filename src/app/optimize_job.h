@@ -18,6 +18,7 @@ struct OptimizeOptions {
   std::string max_memory;     // override the scene's optimizer.max_memory when not empty: a size ("4G", parse_memory_size)
   std::string adjoint;        // override the scene's optimizer.adjoint when not empty ("exact" | "swap")
   double max_seconds = -1;    // override the scene's optimizer.max_seconds (per stage) when >= 0
+  int stop_when_reached = -1;  // override the scene's optimizer.stop_when_reached when 0 or 1 (a bench's)
 };
 
 struct OptimizeOutcome {

@@ -59,6 +59,7 @@ RunFacts run_facts(const StrategyResult& run, const std::vector<HistoryRow>& his
   for (size_t i = 0; i < history.size(); ++i) {
     f.max_objective = std::max(f.max_objective, history[i].rec.phi);
     f.unstable_trials += int(history[i].rec.unstable);
+    f.diverged_trials += int(history[i].rec.diverged);
     best = std::min(best, history[i].rec.phi);
     if (i < earlier) best_earlier = std::min(best_earlier, history[i].rec.phi);
   }
@@ -189,6 +190,7 @@ nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, bool re
   diagnose_run(scene, run, elog, uncontrolled, final_objective, report);
   report["stage_results"] = nlohmann::json::array();
   for (const auto& st : job.stages) report["stage_results"].push_back(stage_json(st));
+  if (!job.weight_scales.empty()) report["keyframe_weight_scales"] = job.weight_scales;
   if (job.throw_search) report["throw_search"] = throw_search_json(*job.throw_search, job.throw_seconds);
   for (const auto& [name, value] : job.sys->run_stats()) report["run_stats"][name] = value;
   if (scene.character) {
@@ -200,11 +202,17 @@ nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, bool re
 }
 
 bool keyframes_met(const Scene& scene, Problem& problem) {
+  for (bool unmet : keyframes_unmet(scene, problem))
+    if (unmet) return false;
+  return true;
+}
+
+std::vector<bool> keyframes_unmet(const Scene& scene, Problem& problem) {
   const nlohmann::json m =
       figure_measures(scene, frames_of(problem.rollout(), problem.time(), problem.system().particles()));
-  for (const KeyframeJudgement& k : judge_keyframes(scene, m, m))
-    if (!k.met()) return false;
-  return true;
+  std::vector<bool> unmet;
+  for (const KeyframeJudgement& k : judge_keyframes(scene, m, m)) unmet.push_back(!k.met());
+  return unmet;
 }
 
 }  // namespace kf

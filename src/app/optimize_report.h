@@ -29,5 +29,7 @@ nlohmann::json write_run_report(const std::filesystem::path& dir, const Scene& s
 // Whether the problem's last rollout (every step kept) meets every keyframe's tolerance, judged as
 // report.json judges the result, from the rollout's frames.
 bool keyframes_met(const Scene& scene, Problem& problem);
+// For each of scene.objectives, whether the problem's last rollout leaves it outside its tolerance.
+std::vector<bool> keyframes_unmet(const Scene& scene, Problem& problem);
 
 }  // namespace kf

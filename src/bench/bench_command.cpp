@@ -157,6 +157,8 @@ void add_reachable_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o
   r->add_option("--reachable-dir", o->reachable.scene_dir, "where the scene files are written")->capture_default_str();
   r->add_option("--reachable-runs", o->reachable.runs_dir, "where each scene's run directory goes")->capture_default_str();
   r->add_flag("--reachable-generate-only", o->reachable.generate_only, "write the scene files and stop");
+  r->add_flag("--reachable-stop-when-reached", o->reachable.stop_when_reached,
+              "every scene with optimizer.stop_when_reached on (measures the stop rule against the default)");
   r->add_option("--reachable-seconds", o->reachable.max_seconds,
                 "wall-time limit of each scene's optimiser stages; a scene passes only within --reachable-pass-seconds")
       ->capture_default_str()->check(CLI::Range(0.0, 1e6));

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
+#include <sys/resource.h>
 #include <mutex>
 #include <thread>
 #include <fstream>
@@ -26,6 +27,14 @@ std::string load_average() {
   std::string a, b, c;
   in >> a >> b >> c;
   return a + " " + b + " " + c;
+}
+
+// CPU seconds (user and system, every thread) this process has used: a job's share of the machine, which a
+// loaded machine inflates far less than its wall seconds.
+double process_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 double median(std::vector<double> v) {
@@ -83,7 +92,7 @@ class JobDeadline {
 
 struct ClassTally {
   int scenes = 0, passed = 0;
-  std::vector<double> evaluations, seconds;
+  std::vector<double> evaluations, seconds, cpu_seconds;
 };
 
 // One scene's optimize job, cut at the pass time, and its report (copied to out/reports/).
@@ -91,7 +100,8 @@ struct SceneRun {
   OptimizeOutcome outcome;
   nlohmann::json report;
   bool cut = false;
-  double seconds = 0;
+  double seconds = 0, cpu_seconds = 0;
+  std::string load;  // the 1-minute load average as the job started
 };
 
 SceneRun run_scene(const ReachableSweepOptions& o, const std::string& name, const std::filesystem::path& file,
@@ -100,8 +110,12 @@ SceneRun run_scene(const ReachableSweepOptions& o, const std::string& name, cons
   opt.out = (o.runs_dir / name).string();
   opt.quiet = true;
   opt.max_seconds = o.max_seconds;
-  std::cerr << "bench reachable: " << name << " (load " << load_average() << ")" << std::endl;
+  if (o.stop_when_reached) opt.stop_when_reached = 1;
   SceneRun run;
+  run.load = load_average();
+  std::cerr << "bench reachable: " << name << " (load " << run.load << ")" << std::endl;
+  run.load = run.load.substr(0, run.load.find(' '));
+  const double cpu_start = process_cpu_seconds();
   const auto start = std::chrono::steady_clock::now();
   {
     JobDeadline deadline(o.pass_seconds);
@@ -109,6 +123,9 @@ SceneRun run_scene(const ReachableSweepOptions& o, const std::string& name, cons
     run.cut = deadline.fired();
   }
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  run.cpu_seconds = process_cpu_seconds() - cpu_start;
+  // A job cut before its first evaluation (a long throw search) writes no run directory: no report.
+  if (!std::filesystem::exists(run.outcome.dir / "report.json")) return run;
   std::ifstream in(run.outcome.dir / "report.json");
   run.report = nlohmann::json::parse(in);
   write_file_atomic(out / "reports" / (name + ".json"), run.report.dump(1) + "\n");
@@ -117,11 +134,13 @@ SceneRun run_scene(const ReachableSweepOptions& o, const std::string& name, cons
 
 // reachable_classes.csv (pass rate, median evaluations, median and worst seconds a class) and its plot.
 void write_class_table(const std::map<std::string, ClassTally>& tally, int rows, const std::filesystem::path& out) {
-  CsvTable classes({"class", "scenes", "passed", "pass_rate", "median_evaluations", "median_seconds", "worst_seconds"});
+  CsvTable classes({"class", "scenes", "passed", "pass_rate", "median_evaluations", "median_seconds", "worst_seconds",
+                    "median_cpu_seconds", "worst_cpu_seconds"});
   for (const auto& [kind, c] : tally)
     classes.add({kind, std::to_string(c.scenes), std::to_string(c.passed), fmt(double(c.passed) / c.scenes),
                  fmt(median(c.evaluations)), fmt(median(c.seconds)),
-                 fmt(*std::max_element(c.seconds.begin(), c.seconds.end()))});
+                 fmt(*std::max_element(c.seconds.begin(), c.seconds.end())), fmt(median(c.cpu_seconds)),
+                 fmt(*std::max_element(c.cpu_seconds.begin(), c.cpu_seconds.end()))});
   classes.write(out / "reachable_classes.csv");
   if (rows > 0)
     bar_plot_csv(out / "reachable_classes.csv", out / "reachable.png", "pass rate by class (1: every scene passed)",
@@ -133,13 +152,14 @@ void write_class_table(const std::map<std::string, ClassTally>& tally, int rows,
 
 nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesystem::path& out) {
   CsvTable t({"scene", "class", "keyframes", "friction", "thrown", "character", "controls", "particles", "keyframe",
-              "miss_before", "miss_after", "evaluations", "seconds", "outcome", "pass"});
+              "miss_before", "miss_after", "evaluations", "seconds", "cpu_seconds", "load", "outcome", "pass"});
   nlohmann::json summary = {{"seed", o.seed}, {"load_before", load_average()}};
   std::map<std::string, ClassTally> tally;
   ensure_directory(o.scene_dir);
   std::signal(SIGHUP, ignore_signal);
   ensure_directory(out / "reports");
   int passed = 0, rows = 0;
+  std::vector<double> all_seconds, all_cpu;
   for (const auto& [name, kind] : reachable_suite(o)) {
     if (!wanted(o, name)) continue;
     const int index = std::stoi(name.substr(name.rfind('-') + 1));
@@ -152,6 +172,21 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
     const bool cut = run.cut;
     const double seconds = run.seconds;
     const nlohmann::json* worst = nullptr;
+    if (report.is_null()) {  // cut before its first evaluation: a failure with nothing measured
+      ++rows;
+      ClassTally& c = tally[kind];
+      ++c.scenes;
+      c.evaluations.push_back(0);
+      c.seconds.push_back(seconds);
+      c.cpu_seconds.push_back(run.cpu_seconds);
+      all_seconds.push_back(seconds);
+      all_cpu.push_back(run.cpu_seconds);
+      t.add({name, kind, std::to_string(r.keyframes), r.friction ? "yes" : "no", r.thrown ? "yes" : "no",
+             r.character ? "yes" : "no", r.scene.at("controls").at("kind").get<std::string>(), "", "", "", "", "0",
+             fmt(seconds), fmt(run.cpu_seconds), run.load, "cut before its first evaluation", "no"});
+      t.write(out / "reachable.csv");
+      continue;
+    }
     for (const auto& k : report.at("keyframe_errors"))
       if (k.at("judged").get<bool>() &&
           (!worst || k.at("miss_after").get<double>() > worst->at("miss_after").get<double>()))
@@ -166,13 +201,16 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
     c.passed += pass;
     c.evaluations.push_back(evaluations);
     c.seconds.push_back(seconds);
+    c.cpu_seconds.push_back(run.cpu_seconds);
+    all_seconds.push_back(seconds);
+    all_cpu.push_back(run.cpu_seconds);
     t.add({name, kind, std::to_string(r.keyframes), r.friction ? "yes" : "no", r.thrown ? "yes" : "no",
            r.character ? "yes" : "no", r.scene.at("controls").at("kind").get<std::string>(),
            std::to_string(r.scene.contains("flock") ? r.scene["flock"]["agents"].get<int>()
                                                     : r.scene["cloth"]["nx"].get<int>() * r.scene["cloth"]["ny"].get<int>()),
            worst->at("name").get<std::string>(), fmt(worst->at("miss_before").get<double>()),
            fmt(worst->at("miss_after").get<double>()), std::to_string(evaluations), fmt(seconds),
-           cut ? "cut" : report.at("diagnosis").at("outcome").get<std::string>(), pass ? "yes" : "no"});
+           fmt(run.cpu_seconds), run.load, cut ? "cut" : report.at("diagnosis").at("outcome").get<std::string>(), pass ? "yes" : "no"});
     t.write(out / "reachable.csv");  // after every scene: a cut-off run keeps what it measured
     summary["diagnoses"][name] = run.outcome.diagnosis;
   }
@@ -181,9 +219,15 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
   summary["load_after"] = load_average();
   summary["passed"] = passed;
   summary["scenes"] = rows;
+  summary["median_seconds"] = median(all_seconds);
+  summary["median_cpu_seconds"] = median(all_cpu);
+  summary["worst_seconds"] = all_seconds.empty() ? 0.0 : *std::max_element(all_seconds.begin(), all_seconds.end());
+  summary["worst_cpu_seconds"] = all_cpu.empty() ? 0.0 : *std::max_element(all_cpu.begin(), all_cpu.end());
   write_file_atomic(out / "load.txt", "load average (1, 5, 15 min) before: " + summary["load_before"].get<std::string>() +
                                           "\nafter: " + summary["load_after"].get<std::string>() + "\n");
-  std::cout << "reachable.csv: " << passed << " of " << rows << " scenes pass" << std::endl;
+  std::cout << "reachable.csv: " << passed << " of " << rows << " scenes pass; median " << fmt(median(all_seconds))
+            << " s (" << fmt(median(all_cpu)) << " CPU s), worst " << summary["worst_seconds"].get<double>() << " s"
+            << std::endl;
   return summary;
 }
 

@@ -57,6 +57,7 @@ struct ReachableSweepOptions {
   int count = 100;                   // scenes, drawn over the classes by their shares
   std::vector<std::string> classes;  // only these (empty: all)
   std::vector<std::string> scenes;   // only these names (empty: all; "smoke": one a class and two more)
+  bool stop_when_reached = false;    // every job with optimizer.stop_when_reached on (else the scene's)
   std::filesystem::path scene_dir = "tests/results/reachable/scenes";  // where the scene files are written
   std::filesystem::path runs_dir = "out/reachable";  // each scene's run directory
   bool generate_only = false;        // write the scene files and stop

@@ -294,6 +294,21 @@ std::string unstable_cause(const RunFacts& facts) {
                         "finer time steps (time.substeps)");
 }
 
+// Every trial step after the start diverged: the run never left its start, and nothing it measured says
+// anything of the target's reach.
+bool every_trial_diverged(const RunFacts& facts) {
+  return facts.evaluations >= 2 && facts.diverged_trials >= facts.evaluations - 1;
+}
+
+std::string diverged_cause(const RunFacts& facts) {
+  return format("cause: every trial step's simulation diverged (%.0f of its %.0f evaluations), so the run never "
+                "left its start; change: ",
+                double(facts.diverged_trials), double(facts.evaluations)) +
+         (facts.flock ? "finer time steps (time.substeps), flock.step \"implicit_damping\", a smaller "
+                        "optimizer.first_step or a later keyframe"
+                      : "finer time steps (time.substeps), a smaller optimizer.first_step or a later keyframe");
+}
+
 // A keyframe the run left where the uncontrolled motion had it (within 10 % of its miss) while another
 // keyframe was met: measured by the two judgements, so it comes before any guessed cause.
 std::string untouched_cause(const std::vector<KeyframeJudgement>& keyframes) {
@@ -313,8 +328,30 @@ std::string untouched_cause(const std::vector<KeyframeJudgement>& keyframes) {
          "; change: raise " + untouched->name + "'s weight, or keyframe it in a scene cut at its frame first";
 }
 
+}  // namespace
+
+int expected_more_evaluations(const RunFacts& facts, double worst_miss) {
+  if (!(facts.recent_improvement < 1.0) || !(facts.recent_improvement > 0.0) || !(worst_miss > 1.0)) return 0;
+  const double tenth = std::max(1.0, facts.evaluations / 10.0);
+  const double tenths = std::log(worst_miss * worst_miss) / std::log(1.0 / facts.recent_improvement);
+  return int(std::ceil(std::min(tenth * tenths, 1e9)));
+}
+
+namespace {
+
+std::string budget_cause(const RunFacts& facts, double worst_miss) {
+  std::string line = format("cause: its budget ended it after %.0f evaluations (the objective still fell %.2gx over "
+                            "the last tenth of them",
+                            facts.evaluations, 1 / std::max(facts.recent_improvement, 1e-300));
+  const int more = expected_more_evaluations(facts, worst_miss);
+  if (more > 0)
+    line += format("; at that rate the worst keyframe needs about %.0f more to come within its tolerance", double(more));
+  return line + "); change: raise optimizer.max_evaluations";
+}
+
 // Noise at the start explains a run that stayed near it; one whose keyframe terms fell tenfold left it.
-std::string likely_cause(const Sensitivity& s, const RunFacts& facts) {
+std::string likely_cause(const Sensitivity& s, const RunFacts& facts, double worst_miss) {
+  if (every_trial_diverged(facts)) return diverged_cause(facts);
   if (unstable_edge(facts)) return unstable_cause(facts);
   if (s.noisy() && facts.keyframe_objective_end > 0.1 * facts.keyframe_objective_start)
     return format("cause: the objective is noise at the start (it moves by %.2g of itself under perturbations "
@@ -326,9 +363,7 @@ std::string likely_cause(const Sensitivity& s, const RunFacts& facts) {
                           "later");
   if (s.amplifying()) return amplifying_cause(s, facts);
   if (facts.budget && (facts.recent_improvement < 0.9 || facts.evaluations < kFewEvaluations))
-    return format("cause: its budget ended it after %.0f evaluations (the objective still fell %.2gx over the "
-                  "last tenth of them); change: raise optimizer.max_evaluations",
-                  facts.evaluations, 1 / std::max(facts.recent_improvement, 1e-300));
+    return budget_cause(facts, worst_miss);
   if (facts.descent.rough()) {
     const DescentProbe& d = facts.descent;
     return "cause: where the optimiser stopped the objective is rough or stiff: along its descent direction it " +
@@ -365,7 +400,7 @@ Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensit
   d.outcome = !d.progress ? "no_progress" : d.far ? "not_reached" : "near";
   const std::string untouched = untouched_cause(keyframes);
   d.line = verdict_head(d, facts) + miss_text(*worst) + budget + "; " +
-           (untouched.empty() ? likely_cause(s, facts) : untouched);
+           (untouched.empty() ? likely_cause(s, facts, worst->miss_after) : untouched);
   return d;
 }
 

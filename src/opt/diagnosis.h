@@ -98,6 +98,7 @@ struct RunFacts {
   DescentProbe descent;              // at the best point, when the keyframes were not reached
   bool flock = false;                // a flock's run: its causes and changes name agents, not sheets
   int unstable_trials = 0;           // evaluations whose simulation the system refused as unstable
+  int diverged_trials = 0;           // evaluations whose simulation diverged (the unstable ones included)
 };
 
 struct Diagnosis {
@@ -109,6 +110,12 @@ struct Diagnosis {
   std::string line;       // one line for the user: what happened, the cause, what to change
   nlohmann::json to_json() const;
 };
+
+// Evaluations a run stopped at its budget expects to need still, from its own progress: keyframe terms scale
+// as the square of a miss, so bringing the worst miss (in tolerances) to 1 divides them by its square; at the
+// rate φ fell over the last tenth of the run (RunFacts::recent_improvement) that takes log(miss²) / log(1 / rate)
+// tenths. 0 when φ no longer fell or nothing is missed.
+int expected_more_evaluations(const RunFacts& facts, double worst_miss);
 
 Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensitivity& sensitivity,
                    const RunFacts& facts);

@@ -1,6 +1,8 @@
 #include "opt/problem.h"
 
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 namespace kf {
@@ -35,9 +37,28 @@ double Problem::control_scale() const {
 
 bool Problem::active(int n) const { return !terms_at_step_[n].empty(); }
 
+void Problem::set_weight_scales(std::vector<double> scales) {
+  if (!scales.empty() && scales.size() != terms_.size())
+    throw std::logic_error("Problem::set_weight_scales: one scale per keyframe term");
+  for (double s : scales)
+    if (!(s > 0) || !std::isfinite(s)) throw std::logic_error("Problem::set_weight_scales: scales must be positive");
+  scales_ = std::move(scales);
+  if (std::all_of(scales_.begin(), scales_.end(), [](double s) { return s == 1.0; })) scales_.clear();
+}
+
+double Problem::eval_term(int k, const VecX& x, const VecX& v, VecX& gx, VecX& gv) const {
+  if (scales_.empty() || scales_[k] == 1.0) return terms_[k]->eval(x, v, gx, gv);
+  gx_term_.setZero(x.size());  // sized once: the vectors are kept between calls
+  gv_term_.setZero(v.size());
+  const double g = terms_[k]->eval(x, v, gx_term_, gv_term_);
+  gx += scales_[k] * gx_term_;
+  gv += scales_[k] * gv_term_;
+  return scales_[k] * g;
+}
+
 double Problem::eval(int n, const VecX& x, const VecX& v, VecX& gx, VecX& gv) const {
   double g = 0;
-  for (int k : terms_at_step_[n]) g += terms_[k]->eval(x, v, gx, gv);
+  for (int k : terms_at_step_[n]) g += eval_term(k, x, v, gx, gv);
   return g;
 }
 
@@ -71,7 +92,7 @@ bool Problem::objective_of_rollout(const VecX& z, VecX* grad, const StepControl&
   VecX gx = VecX::Zero(sys_.dof()), gv = VecX::Zero(sys_.dof());
   for (size_t k = 0; k < terms_.size(); ++k) {
     const int n = terms_[k]->frame() * time_.substeps;
-    const double g = terms_[k]->eval(rollout_.x[n], rollout_.v[n], gx, gv);
+    const double g = eval_term(int(k), rollout_.x[n], rollout_.v[n], gx, gv);
     breakdown_.emplace_back(terms_[k]->name() + "@" + std::to_string(terms_[k]->frame()), g);
     phi += g;
   }

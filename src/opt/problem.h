@@ -50,7 +50,13 @@ class Problem : public StateCost {
   void set_memory_budget(std::size_t bytes) { memory_budget_ = bytes; }
   std::size_t memory_budget() const { return memory_budget_; }
 
-  // Values of each term (keyframe terms by name, then "effort") at the last evaluated point.
+  // Each keyframe term's weight is multiplied by scales[k] (scene.objectives order; empty: all 1), so a
+  // stage may press on keyframes the scene's weights let the effort trade away (opt/keyframe_weights.h).
+  void set_weight_scales(std::vector<double> scales);
+  const std::vector<double>& weight_scales() const { return scales_; }
+
+  // Values of each term (keyframe terms by name, then "effort") at the last evaluated point, weighted as φ
+  // sums them (with the weight scales).
   const std::vector<std::pair<std::string, double>>& breakdown() const { return breakdown_; }
   // The states of the last evaluated point (valid unless it diverged; with checkpointing and a
   // gradient only the kept ones, see Rollout::kept).
@@ -65,6 +71,8 @@ class Problem : public StateCost {
   // either is not finite. The bowl evaluate gives instead for a point that diverged.
   bool objective_of_rollout(const VecX& z, VecX* grad, const StepControl& u_at, long double& phi);
   double diverged_objective(const VecX& z, VecX* grad);
+  // Term k's value and gradient (added to gx, gv), times its weight scale.
+  double eval_term(int k, const VecX& x, const VecX& v, VecX& gx, VecX& gv) const;
 
   TimeSpec time_;
   System& sys_;
@@ -72,6 +80,8 @@ class Problem : public StateCost {
   Controls controls_;
   std::vector<std::unique_ptr<ObjectiveTerm>> terms_;
   std::vector<std::vector<int>> terms_at_step_;  // term indices per step
+  std::vector<double> scales_;                   // per term; empty: all 1
+  mutable VecX gx_term_, gv_term_;               // one scaled term's gradient, before it is added
   VecX v0_;
   VecX u_;  // control force of the step being simulated
   int checkpoint_every_ = 0;

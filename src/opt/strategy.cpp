@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
 #include "core/error.h"
+#include "opt/keyframe_weights.h"
 #include "opt/restarts.h"
 #include "opt/throw_fit.h"
 
@@ -26,6 +28,7 @@ struct Run {
   StrategyLog& log;
   std::uint64_t all_evaluations = 0;  // recorded on one tape over all stages
   TimeSpec z_time;                    // the time discretisation the controls in r.z were made for
+  std::vector<double> weight_scales;  // the keyframe weights' scales every new stage's problem gets
   StrategyResult r;
 };
 
@@ -45,6 +48,7 @@ std::string set_up_stage(Run& run, const StageSpec& stage) {
     r.problem->controls().initial_velocity(z, v0_before);
   r.problem = std::make_unique<Problem>(stage_scene, r.time, *r.sys);
   Problem& problem = *r.problem;
+  problem.set_weight_scales(run.weight_scales);
   r.tape.begin_stage({std::uint64_t(problem.size()), problem.controls().kind(), problem.controls().first_frame(),
                       r.time.substeps});
   r.tape.expect(std::uint64_t(problem.size()), run.all_evaluations);
@@ -265,6 +269,57 @@ void windows_after_early_end(Run& run, std::vector<StageSpec>& stages) {
   if (r.hold_splits) r.sys->hold_step_schedule(r.schedule);
 }
 
+// The keyframe terms of the problem's last evaluation at the scene's weights (infinite after a divergence).
+double scene_keyframe_terms(const Problem& problem) {
+  const auto& terms = problem.breakdown();
+  const auto& scales = problem.weight_scales();
+  if (terms.empty() || terms.back().first != "effort") return INFINITY;
+  double sum = 0;
+  for (size_t k = 0; k + 1 < terms.size(); ++k) sum += terms[k].second / (scales.empty() ? 1.0 : scales[k]);
+  return sum;
+}
+
+// Keyframes are met, effort is minimised (opt/keyframe_weights.h): after a last stage that ended early with a
+// keyframe outside its tolerance, stages with that keyframe's weight raised, from the best point, with the
+// evaluations the plan has left; appended to `stages`.
+void press_missed_keyframes(Run& run, std::vector<StageSpec>& stages) {
+  StrategyResult& r = run.r;
+  const KeyframeWeightRule rule;
+  if (run.scene.optimizer.soft_keyframes || !run.hooks.keyframes_unmet || run.fixed_budgets) return;
+  for (int round = 0; round < rule.rounds; ++round) {
+    if (r.stages.empty() || !r.problem || r.interrupted || !ended_early(r.stages.back().reason)) return;
+    Problem& problem = *r.problem;
+    problem.evaluate(r.z, nullptr);  // every state kept: the judgement reads the frames
+    if (problem.last_diverged()) return;
+    const std::vector<bool> unmet = run.hooks.keyframes_unmet(problem);
+    if (!any_unmet(unmet)) return;
+    const int left = int(run.all_evaluations) - r.evaluations;
+    if (left < rule.min_evaluations) return;
+    const double before = scene_keyframe_terms(problem);
+    std::vector<std::string> names;
+    for (const auto& term : problem.breakdown()) names.push_back(term.first);
+    run.weight_scales = raised_weight_scales(problem.weight_scales(), unmet, rule, round + 1);
+    run.log.say(describe_raise(names, run.weight_scales, unmet) + " with " + std::to_string(left) + " evaluations");
+    const VecX z_before = r.z;
+    const StepSchedule schedule_before = r.schedule;
+    stages.push_back(StageSpec{r.time.substeps, left, std::nullopt});
+    ++r.weight_rounds;
+    run_stages(run, stages, stages.size() - 1);
+    if (r.interrupted) return;
+    r.problem->evaluate(r.z, nullptr);
+    const double after = scene_keyframe_terms(*r.problem);
+    if (after < rule.keep_below * before) continue;
+    std::ostringstream os;
+    os << std::scientific << std::setprecision(3) << "the raised weights took the keyframe terms from " << before
+       << " to " << after << ": the point before them is kept";
+    run.log.say(os.str());
+    r.z = z_before;
+    r.schedule = schedule_before;
+    if (r.hold_splits) r.sys->hold_step_schedule(r.schedule);
+    return;
+  }
+}
+
 }  // namespace
 
 StrategyResult run_strategy(StrategySetup setup, const StrategyHooks& hooks, StrategyLog& log) {
@@ -285,6 +340,9 @@ StrategyResult run_strategy(StrategySetup setup, const StrategyHooks& hooks, Str
   r.hold_splits = scene.cloth && scene.optimizer.split_schedule == SplitSchedule::kHeld;
   run_stages(run, stages, 0);
   windows_after_early_end(run, stages);
+  press_missed_keyframes(run, stages);
+  r.weight_scales = run.weight_scales;
+  if (r.problem) r.problem->set_weight_scales({});
   r.planned_stages = int(stages.size());
   return std::move(run.r);
 }

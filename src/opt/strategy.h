@@ -47,6 +47,10 @@ struct StrategyHooks {
   // optimizer.stop_when_reached: whether the problem's last rollout (every step kept) meets every
   // keyframe's tolerance. Empty: the run never stops for it.
   std::function<bool(Problem&)> keyframes_met;
+  // For each of the scene's objectives, whether the problem's last rollout (every step kept) leaves it outside
+  // its tolerance: the keyframes whose weights a run that ended early raises (opt/keyframe_weights.h).
+  // Empty: weights are never raised.
+  std::function<std::vector<bool>(Problem&)> keyframes_unmet;
 };
 
 // One stage as it ended.
@@ -90,6 +94,10 @@ struct StrategyResult {
   int planned_stages = 0;  // the plan's, with the windows after an early end
   bool hold_splits = false;  // optimizer.split_schedule "held", on cloth
   StepSchedule schedule;     // the step schedule the last stage held
+  // Each keyframe's weight over the scene's in the last stage (empty: the scene's); the result's problem is
+  // left at the scene's weights, so what a report evaluates is the scene's objective.
+  std::vector<double> weight_scales;
+  int weight_rounds = 0;  // stages run with raised keyframe weights
   std::optional<ThrowSearch> throw_search;  // what the search over rigid throws found
   double throw_seconds = 0;
   // Sets the system's schedule as the result's optimisation saw it (after simulating anything else).

@@ -308,6 +308,7 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls, int fr
   o.window_growth = b.number("window_growth", o.window_growth, 1.0, 1e300);
   if (b.has("first_step")) o.first_step = b.number("first_step", 0.0, 0.0, 1e12);
   o.stop_when_reached = b.boolean("stop_when_reached", o.stop_when_reached);
+  o.soft_keyframes = b.boolean("soft_keyframes", o.soft_keyframes);
   b.finish();
   return o;
 }

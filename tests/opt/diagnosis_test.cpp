@@ -205,5 +205,25 @@ TEST(Diagnosis, TrialsRefusedAsUnstableAreNamedWhenThereAreMany) {
   EXPECT_EQ(few.find("refused as unstable"), std::string::npos) << few;
 }
 
+// A budget stop says how many more evaluations its own progress expects: the worst miss of 4 tolerances
+// needs the keyframe terms 16x lower; falling 2x a tenth (30 evaluations) that is 4 tenths, 120 evaluations.
+TEST(Diagnosis, ABudgetStopStatesTheEvaluationsItExpectsToNeed) {
+  RunFacts f;
+  f.evaluations = 300;
+  f.recent_improvement = 0.5;
+  EXPECT_EQ(expected_more_evaluations(f, 4.0), 120);
+  EXPECT_EQ(expected_more_evaluations(f, 1.0), 0);  // nothing missed
+  f.recent_improvement = 1.0;
+  EXPECT_EQ(expected_more_evaluations(f, 4.0), 0);  // no longer falling: no estimate
+  Sensitivity s;
+  s.growth = s.growth_beyond_free = 1.5;
+  RunFacts g = facts(10, 9, "evaluation limit reached");
+  g.evaluations = 60;
+  g.recent_improvement = 0.5;
+  const std::string line = diagnose(one_keyframe(15, 4), s, g).line;
+  EXPECT_NE(line.find("budget ended it after 60 evaluations"), std::string::npos) << line;
+  EXPECT_NE(line.find("needs about 24 more"), std::string::npos) << line;
+}
+
 }  // namespace
 }  // namespace kf

@@ -104,5 +104,53 @@ TEST(DiagnosisTruth, GeneratedDropNamesTheEarlyKeyframeLeftBehind) {
   EXPECT_NE(outcome.diagnosis.find("was left at its uncontrolled error"), std::string::npos) << outcome.diagnosis;
 }
 
+// A flock whose every trial step diverged never left its start: the diagnosis says it diverged, not that
+// the target is likely out of reach (which nothing the run measured says).
+TEST(DiagnosisTruth, AFlockWhoseEveryTrialDivergedIsNotCalledOutOfReach) {
+  const std::vector<KeyframeJudgement> k = {judged("center_of_mass@12", 12, 50.0, 50.0, "254 cm", "254 cm")};
+  RunFacts f = run(10, 10, "converged");
+  f.flock = true;
+  f.evaluations = 12;
+  f.diverged_trials = 11;  // every evaluation after the start
+  const std::string line = diagnose(k, Sensitivity{}, f).line;
+  EXPECT_EQ(line.find("out of reach"), std::string::npos) << line;
+  EXPECT_NE(line.find("every trial step's simulation diverged (11 of its 12 evaluations)"), std::string::npos) << line;
+  EXPECT_NE(line.find("implicit_damping"), std::string::npos) << line;
+  f.diverged_trials = 5;  // some trials came back: the usual causes apply
+  EXPECT_EQ(diagnose(k, Sensitivity{}, f).line.find("every trial step"), std::string::npos);
+}
+
+// The generated suite's committed reports (tests/results/reachable/*/reports): a failure's diagnosis says
+// "noise at the start" only where the run measured a noisy start and its keyframe terms stayed above a tenth
+// of where they began, and "out of reach" only for a run that stopped on its own (not at a budget or a cut),
+// with smooth dynamics, at keyframe terms its raised weights (if any) did not bring down further.
+TEST(DiagnosisTruth, CommittedGeneratedFailuresNameOnlyWhatTheyMeasured) {
+  namespace fs = std::filesystem;
+  const fs::path root = fs::path(KEYFRAME_SOURCE_DIR) / "tests/results/reachable";
+  int reports = 0;
+  for (const auto& dir : fs::directory_iterator(root)) {
+    if (!fs::is_directory(dir.path() / "reports")) continue;
+    for (const auto& file : fs::directory_iterator(dir.path() / "reports")) {
+      std::ifstream in(file.path());
+      const nlohmann::json r = nlohmann::json::parse(in);
+      ++reports;
+      const nlohmann::json& d = r.at("diagnosis");
+      if (!d.at("failed").get<bool>()) continue;
+      const std::string line = d.at("diagnosis").get<std::string>();
+      const std::string where = file.path().string() + ": " + line;
+      if (line.find("noise at the start") != std::string::npos) {
+        EXPECT_GT(r.at("sensitivity").at("objective_relative_noise_start").get<double>(), 1e-6) << where;
+        EXPECT_GT(d.at("keyframe_objective_end").get<double>(), 0.1 * d.at("keyframe_objective_start").get<double>())
+            << where;
+      }
+      if (line.find("out of reach") != std::string::npos) {
+        EXPECT_FALSE(d.at("budget_reached").get<bool>()) << where;
+        EXPECT_EQ(line.find("diverged"), std::string::npos) << where;
+      }
+    }
+  }
+  EXPECT_GE(reports, 12);
+}
+
 }  // namespace
 }  // namespace kf

@@ -1,0 +1,29 @@
+#!/usr/bin/env python3
+"""Merges reachable.csv files of `keyframe bench --only reachable` runs (a run split over classes, or cut off
+before its class table) into one table a class: scenes, passed, pass rate, median evaluations, median and
+worst wall seconds, median and worst CPU seconds, and a row "all".
+
+Usage: scripts/reachable_classes.py OUT.csv IN.csv ..."""
+import csv, statistics, sys
+
+if len(sys.argv) < 3:
+    raise SystemExit(__doc__)
+rows = [r for f in sys.argv[2:] for r in csv.DictReader(open(f))]
+groups = {}
+for r in rows:
+    groups.setdefault(r["class"], []).append(r)
+groups = dict(sorted(groups.items()))
+groups["all"] = rows
+fields = ["class", "scenes", "passed", "pass_rate", "median_evaluations", "median_seconds", "worst_seconds",
+          "median_cpu_seconds", "worst_cpu_seconds"]
+with open(sys.argv[1], "w", newline="") as out:
+    w = csv.writer(out)
+    w.writerow(fields)
+    for kind, rs in groups.items():
+        secs = [float(r["seconds"]) for r in rs]
+        cpu = [float(r["cpu_seconds"]) for r in rs]
+        passed = sum(r["pass"] == "yes" for r in rs)
+        w.writerow([kind, len(rs), passed, "%.3f" % (passed / len(rs)),
+                    "%g" % statistics.median(float(r["evaluations"]) for r in rs),
+                    "%.1f" % statistics.median(secs), "%.1f" % max(secs),
+                    "%.1f" % statistics.median(cpu), "%.1f" % max(cpu)])
