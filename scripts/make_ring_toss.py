@@ -180,8 +180,9 @@ def make(n, frames, key_frames, keyed, max_evaluations):
         "objectives": objectives,
         "controls": {"kind": "initial_velocity", "alpha": 1e-6},
         # The default plan: the throw fitted to the keyframes and a search over throws, the rigid throw, a
-        # lattice of initial velocities, then one per particle.
-        "optimizer": {"ftol_rel": 1e-10, "max_evaluations": max_evaluations},
+        # lattice of initial velocities, then one per particle; every stage runs (no stop when reached), as
+        # in the other figures of the paper.
+        "optimizer": {"stop_when_reached": False, "ftol_rel": 1e-10, "max_evaluations": max_evaluations},
         "render": {"camera": {"eye": [0.6, 1.5, 4.4], "target": [0.6, 0.75, 0]}},  # the whole flight, side on
     }
     return scene, summary

@@ -74,6 +74,7 @@ TEST(Resume, InterruptedThenResumedRunMatchesAnUninterruptedOne) {
   const int whole_code = run_keyframe(dir, {"optimize", "small.json", "--out", "whole"});
   ASSERT_TRUE(whole_code == 0 || whole_code == kExitNotReached) << whole_code;
   const double whole = final_objective(dir / "whole");
+  const int whole_evaluations = nlohmann::json::parse(std::ifstream(dir / "whole" / "report.json")).at("evaluations");
 
   // Cut in the first stage (3 evaluations) and in a stage with raised keyframe weights (40).
   for (const int cut_after : {3, 40}) {
@@ -83,9 +84,9 @@ TEST(Resume, InterruptedThenResumedRunMatchesAnUninterruptedOne) {
     std::ifstream report(dir / cut / "report.json");
     const auto j = nlohmann::json::parse(report);
     EXPECT_TRUE(j.at("interrupted").get<bool>());
-    const double at_cut = j.at("final_objective").get<double>();
+    EXPECT_LT(j.at("evaluations").get<int>(), whole_evaluations) << "the interrupted run had already finished";
     if (cut_after == 3) {
-      EXPECT_GT(at_cut, whole * 1.01) << "the interrupted run had already converged; interrupt earlier";
+      EXPECT_EQ(j.at("stage_results").size(), 1u) << "cut after the first stage";
     } else {
       EXPECT_GT(j.at("keyframe_weight_scales").at(0).get<double>(), 1.0) << "cut before the weights were raised";
     }
