@@ -148,6 +148,35 @@ void write_class_table(const std::map<std::string, ClassTally>& tally, int rows,
   std::cout << classes.excerpt(100) << std::endl;
 }
 
+// One scene's figures added to its class and to the whole suite's.
+void count_scene(ClassTally& c, bool pass, int evaluations, const SceneRun& run, std::vector<double>& all_seconds,
+                 std::vector<double>& all_cpu) {
+  ++c.scenes;
+  c.passed += pass;
+  c.evaluations.push_back(evaluations);
+  c.seconds.push_back(run.seconds);
+  c.cpu_seconds.push_back(run.cpu_seconds);
+  all_seconds.push_back(run.seconds);
+  all_cpu.push_back(run.cpu_seconds);
+}
+
+// The suite's totals into the summary and load.txt, and one line to the terminal.
+void finish_summary(nlohmann::json& summary, int passed, int rows, const std::vector<double>& all_seconds,
+                    const std::vector<double>& all_cpu, const std::filesystem::path& out) {
+  summary["load_after"] = load_average();
+  summary["passed"] = passed;
+  summary["scenes"] = rows;
+  summary["median_seconds"] = median(all_seconds);
+  summary["median_cpu_seconds"] = median(all_cpu);
+  summary["worst_seconds"] = all_seconds.empty() ? 0.0 : *std::max_element(all_seconds.begin(), all_seconds.end());
+  summary["worst_cpu_seconds"] = all_cpu.empty() ? 0.0 : *std::max_element(all_cpu.begin(), all_cpu.end());
+  write_file_atomic(out / "load.txt", "load average (1, 5, 15 min) before: " + summary["load_before"].get<std::string>() +
+                                          "\nafter: " + summary["load_after"].get<std::string>() + "\n");
+  std::cout << "reachable.csv: " << passed << " of " << rows << " scenes pass; median " << fmt(median(all_seconds))
+            << " s (" << fmt(median(all_cpu)) << " CPU s), worst " << summary["worst_seconds"].get<double>() << " s"
+            << std::endl;
+}
+
 }  // namespace
 
 nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesystem::path& out) {
@@ -174,13 +203,7 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
     const nlohmann::json* worst = nullptr;
     if (report.is_null()) {  // cut before its first evaluation: a failure with nothing measured
       ++rows;
-      ClassTally& c = tally[kind];
-      ++c.scenes;
-      c.evaluations.push_back(0);
-      c.seconds.push_back(seconds);
-      c.cpu_seconds.push_back(run.cpu_seconds);
-      all_seconds.push_back(seconds);
-      all_cpu.push_back(run.cpu_seconds);
+      count_scene(tally[kind], false, 0, run, all_seconds, all_cpu);
       t.add({name, kind, std::to_string(r.keyframes), r.friction ? "yes" : "no", r.thrown ? "yes" : "no",
              r.character ? "yes" : "no", r.scene.at("controls").at("kind").get<std::string>(), "", "", "", "", "0",
              fmt(seconds), fmt(run.cpu_seconds), run.load, "cut before its first evaluation", "no"});
@@ -196,14 +219,7 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
     const int evaluations = report.at("evaluations").get<int>();
     passed += pass;
     ++rows;
-    ClassTally& c = tally[kind];
-    ++c.scenes;
-    c.passed += pass;
-    c.evaluations.push_back(evaluations);
-    c.seconds.push_back(seconds);
-    c.cpu_seconds.push_back(run.cpu_seconds);
-    all_seconds.push_back(seconds);
-    all_cpu.push_back(run.cpu_seconds);
+    count_scene(tally[kind], pass, evaluations, run, all_seconds, all_cpu);
     t.add({name, kind, std::to_string(r.keyframes), r.friction ? "yes" : "no", r.thrown ? "yes" : "no",
            r.character ? "yes" : "no", r.scene.at("controls").at("kind").get<std::string>(),
            std::to_string(r.scene.contains("flock") ? r.scene["flock"]["agents"].get<int>()
@@ -216,18 +232,7 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
   }
   if (o.generate_only) return summary;
   write_class_table(tally, rows, out);
-  summary["load_after"] = load_average();
-  summary["passed"] = passed;
-  summary["scenes"] = rows;
-  summary["median_seconds"] = median(all_seconds);
-  summary["median_cpu_seconds"] = median(all_cpu);
-  summary["worst_seconds"] = all_seconds.empty() ? 0.0 : *std::max_element(all_seconds.begin(), all_seconds.end());
-  summary["worst_cpu_seconds"] = all_cpu.empty() ? 0.0 : *std::max_element(all_cpu.begin(), all_cpu.end());
-  write_file_atomic(out / "load.txt", "load average (1, 5, 15 min) before: " + summary["load_before"].get<std::string>() +
-                                          "\nafter: " + summary["load_after"].get<std::string>() + "\n");
-  std::cout << "reachable.csv: " << passed << " of " << rows << " scenes pass; median " << fmt(median(all_seconds))
-            << " s (" << fmt(median(all_cpu)) << " CPU s), worst " << summary["worst_seconds"].get<double>() << " s"
-            << std::endl;
+  finish_summary(summary, passed, rows, all_seconds, all_cpu, out);
   return summary;
 }
 

@@ -135,22 +135,8 @@ std::vector<int> named_pin_set(const std::string& name, int nx, int ny) {
   return out;
 }
 
-ClothSpec parse_cloth_spec(Block& b, const std::filesystem::path& directory) {
-  ClothSpec s;
-  if (b.has("mesh")) {
-    s.mesh = parse_cloth_mesh(b.child("mesh"), directory);
-    s.mass_by_area = b.string("mass_by", "area", {"area", "uniform"}) == "area";
-  } else {
-    s.nx = b.integer("nx", s.nx, 2, 1024);
-    s.ny = b.integer("ny", s.ny, 2, 1024);
-    s.width = b.number("width", s.width, 1e-4, 1e4);
-    s.height = b.number("height", s.height, 1e-4, 1e4);
-    s.origin = b.vec3("origin", s.origin);
-    s.u_axis = unit_vec3(b, "u_axis", s.u_axis);
-    s.v_axis = unit_vec3(b, "v_axis", s.v_axis);
-    if (std::abs(s.u_axis.dot(s.v_axis)) > 1e-6) b.fail("v_axis", "expected a direction perpendicular to \"u_axis\"");
-  }
-  s.mass = b.number("mass", s.mass, 1e-9, 1e6);
+// The pinned particles: a rest-space box, a named group, a named edge set, a selector or indices.
+static void parse_pins(Block& b, ClothSpec& s) {
   const int p = s.particles();
   if (b.has("pins") && is_rest_box(b.json().at("pins"))) {
     Block region = b.child("pins");
@@ -170,6 +156,41 @@ ClothSpec parse_cloth_spec(Block& b, const std::filesystem::path& directory) {
     std::sort(s.pins.begin(), s.pins.end());
     s.pins.erase(std::unique(s.pins.begin(), s.pins.end()), s.pins.end());
   }
+}
+
+// cloth.self: contact of the sheet with itself.
+static void parse_self_contact(Block& b, ClothSpec& s) {
+  s.self_stated = b.has("self");
+  if (s.self_stated) {
+    Block self = b.child("self");
+    // Pairs closer than the particle spacing repel: farther apart, a layer's particles slip between another's.
+    const double spacing = s.mesh ? s.self.thickness : std::min(s.width / (s.nx - 1), s.height / (s.ny - 1));
+    s.self.enabled = self.boolean("enabled", true);
+    s.self.thickness = self.number("thickness", spacing, 1e-5, 1.0);
+    s.self.stiffness = self.number("stiffness", s.self.stiffness, 0.0, 1e8);
+    s.self.friction = self.number("friction", s.self.friction, 0.0, 10.0);
+    s.self.friction_velocity = self.number("friction_velocity", s.self.friction_velocity, 1e-6, 100.0);
+    self.finish();
+  }
+}
+
+ClothSpec parse_cloth_spec(Block& b, const std::filesystem::path& directory) {
+  ClothSpec s;
+  if (b.has("mesh")) {
+    s.mesh = parse_cloth_mesh(b.child("mesh"), directory);
+    s.mass_by_area = b.string("mass_by", "area", {"area", "uniform"}) == "area";
+  } else {
+    s.nx = b.integer("nx", s.nx, 2, 1024);
+    s.ny = b.integer("ny", s.ny, 2, 1024);
+    s.width = b.number("width", s.width, 1e-4, 1e4);
+    s.height = b.number("height", s.height, 1e-4, 1e4);
+    s.origin = b.vec3("origin", s.origin);
+    s.u_axis = unit_vec3(b, "u_axis", s.u_axis);
+    s.v_axis = unit_vec3(b, "v_axis", s.v_axis);
+    if (std::abs(s.u_axis.dot(s.v_axis)) > 1e-6) b.fail("v_axis", "expected a direction perpendicular to \"u_axis\"");
+  }
+  s.mass = b.number("mass", s.mass, 1e-9, 1e6);
+  parse_pins(b, s);
   s.stretch = b.number("stretch", s.stretch, 0.0, 1e9);
   s.shear = b.number("shear", s.shear, 0.0, 1e9);
   s.bend = b.number("bend", s.bend, 0.0, 1e9);
@@ -192,18 +213,7 @@ ClothSpec parse_cloth_spec(Block& b, const std::filesystem::path& directory) {
   s.transverse_ramp = b.number("transverse_ramp", s.transverse_ramp, 1e-4, 1.0);
   s.theta = b.number("theta", s.theta, 0.5, 1.0);
   for (Block& c : b.array("colliders")) s.colliders.push_back(parse_collider(std::move(c)));
-  s.self_stated = b.has("self");
-  if (s.self_stated) {
-    Block self = b.child("self");
-    // Pairs closer than the particle spacing repel: farther apart, a layer's particles slip between another's.
-    const double spacing = s.mesh ? s.self.thickness : std::min(s.width / (s.nx - 1), s.height / (s.ny - 1));
-    s.self.enabled = self.boolean("enabled", true);
-    s.self.thickness = self.number("thickness", spacing, 1e-5, 1.0);
-    s.self.stiffness = self.number("stiffness", s.self.stiffness, 0.0, 1e8);
-    s.self.friction = self.number("friction", s.self.friction, 0.0, 10.0);
-    s.self.friction_velocity = self.number("friction_velocity", s.self.friction_velocity, 1e-6, 100.0);
-    self.finish();
-  }
+  parse_self_contact(b, s);
   b.finish();
   return s;
 }
