@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "core/check.h"
+#include "core/box_frame.h"
 #include "core/overloaded.h"
 #include "render/geometry/primitives.h"
 #include "render/geometry/system_geometry.h"
@@ -9,14 +10,6 @@
 namespace kf::render {
 
 namespace {
-// World from box: the unit u and v axes and u x v as columns.
-Mat3 box_axes(const Vec3& u, const Vec3& v) {
-  Mat3 r;
-  r.col(0) = u.normalized();
-  r.col(1) = v.normalized();
-  r.col(2) = r.col(0).cross(r.col(1));
-  return r;
-}
 void add_box_corners(const Vec3& c, const Mat3& axes, const Vec3& half, Bounds& b) {
   for (int k = 0; k < 8; ++k)
     b.add(c + axes * Vec3(k & 1 ? half.x() : -half.x(), k & 2 ? half.y() : -half.y(), k & 4 ? half.z() : -half.z()));
@@ -30,11 +23,11 @@ void add_collider(Mesh& m, const ColliderShape& shape, const Vec3& color) {
                  [&](const TorusShape& t) { add_torus(m, t.center, t.axis, t.radius, t.tube_radius, color); },
                  [&](const CapsuleShape& c) { add_capsule(m, c.a, c.b, c.radius, color); },
                  [&](const BoxShape& s) {
-                   add_rounded_box(m, s.center, box_axes(s.u_axis, s.v_axis), 0.5 * s.size - Vec3::Constant(s.radius),
+                   add_rounded_box(m, s.center, box_frame(s.u_axis, s.v_axis), 0.5 * s.size - Vec3::Constant(s.radius),
                                    s.radius, color);
                  },
                  [&](const RectangleShape& s) {  // both sides, each facing out
-                   const Mat3 r = box_axes(s.u_axis, s.v_axis);
+                   const Mat3 r = box_frame(s.u_axis, s.v_axis);
                    const Vec3 u = 0.5 * s.width * r.col(0), v = 0.5 * s.height * r.col(1), c = s.center;
                    add_flat_quad(m, c - u - v, c + u - v, c + u + v, c - u + v, r.col(2), color);
                    add_flat_quad(m, c - u - v, c - u + v, c + u + v, c + u - v, -r.col(2), color);
@@ -67,9 +60,9 @@ void add_collider_bounds(const ColliderShape& shape, Bounds& b) {
                    b.add(c.a.cwiseMin(c.b) - Vec3::Constant(c.radius));
                    b.add(c.a.cwiseMax(c.b) + Vec3::Constant(c.radius));
                  },
-                 [&](const BoxShape& s) { add_box_corners(s.center, box_axes(s.u_axis, s.v_axis), 0.5 * s.size, b); },
+                 [&](const BoxShape& s) { add_box_corners(s.center, box_frame(s.u_axis, s.v_axis), 0.5 * s.size, b); },
                  [&](const RectangleShape& s) {
-                   add_box_corners(s.center, box_axes(s.u_axis, s.v_axis), Vec3(0.5 * s.width, 0.5 * s.height, 0), b);
+                   add_box_corners(s.center, box_frame(s.u_axis, s.v_axis), Vec3(0.5 * s.width, 0.5 * s.height, 0), b);
                  },
              },
              shape);

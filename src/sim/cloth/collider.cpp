@@ -7,6 +7,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/box_frame.h"
 #include "core/overloaded.h"
 
 namespace kf {
@@ -181,27 +182,18 @@ void CapsuleCollider::distance(const Vec3& x, double& phi, Vec3& normal, Mat3& d
   dnormal_dx = side ? Mat3(across * (Mat3::Identity() - axis_ * axis_.transpose())) : across;
 }
 
-namespace {
-Mat3 frame_of(const Vec3& u, const Vec3& v) {
-  Mat3 r;
-  r.col(0) = u.normalized();
-  r.col(1) = v.normalized();
-  r.col(2) = r.col(0).cross(r.col(1));
-  return r;
-}
-}  // namespace
 
 BoxCollider::BoxCollider(const BoxShape& s, double thickness, double stiffness, double ramp)
     : DistanceCollider(thickness, stiffness, ramp),
       center_(s.center),
-      axes_(frame_of(s.u_axis, s.v_axis)),
+      axes_(box_frame(s.u_axis, s.v_axis)),
       half_((0.5 * s.size - Vec3::Constant(s.radius)).cwiseMax(0.0)),
       radius_(s.radius) {}
 
 BoxCollider::BoxCollider(const RectangleShape& s, double thickness, double stiffness, double ramp)
     : DistanceCollider(thickness, stiffness, ramp),
       center_(s.center),
-      axes_(frame_of(s.u_axis, s.v_axis)),
+      axes_(box_frame(s.u_axis, s.v_axis)),
       half_(0.5 * s.width, 0.5 * s.height, 0.0),
       radius_(0.0) {}
 
