@@ -3,7 +3,8 @@
 #
 # A mesh object becomes the cloth (its vertices the particles, in Blender's order); vertex groups name the pins
 # and the keyframed sets; an Empty's location at a frame is a set's target (its centre of mass, or every vertex
-# carried rigidly by the Empty); spheres, cylinders (as capsules), planes and tori become colliders. The scene
+# carried rigidly by the Empty); spheres, cylinders (as capsules), cubes (as boxes), planes and tori become
+# colliders. The scene
 # is written in keyframe's frame (Y up: Blender's (x, y, z) is keyframe's (x, z, -y)) beside the mesh as OBJ,
 # so the same file runs from the shell or on the farm.
 bl_info = {
@@ -36,6 +37,11 @@ EVALUATION_LINE = re.compile(r"eval\s+(\d+)\s+phi\s+(\S+)")
 
 def to_keyframe(p):
     return [float(p[0]), float(p[2]), float(-p[1])]
+
+
+def unit(a):
+    n = sum(x * x for x in a) ** 0.5
+    return [x / n for x in a]
 
 
 def from_keyframe(q):
@@ -73,8 +79,9 @@ class KeyframeObject(bpy.types.PropertyGroup):
     pin_group: bpy.props.StringProperty(name="Pins", description="Vertex group held in place")
     targets: bpy.props.CollectionProperty(type=KeyframeTarget)
     shape: bpy.props.EnumProperty(name="Shape", default='AUTO', items=[
-        ('AUTO', "Detect", "From the mesh's name: Sphere, Cylinder, Plane, Torus"),
+        ('AUTO', "Detect", "From the mesh's name: Sphere, Cylinder, Cube, Plane, Torus"),
         ('SPHERE', "Sphere", ""), ('CAPSULE', "Capsule", "A cylinder with round ends"),
+        ('BOX', "Box", "A cube or cuboid, along the object's axes"),
         ('PLANE', "Plane", "The infinite plane, free side along the object's Z"), ('TORUS', "Torus", "")])
     friction: bpy.props.FloatProperty(name="Friction", default=0, min=0, max=10)
 
@@ -143,14 +150,16 @@ def collider_spec(obj):
     if shape == 'AUTO':
         name = (obj.data.name if obj.data else obj.name).lower()
         for prefix, kind in (("sphere", 'SPHERE'), ("icosphere", 'SPHERE'), ("cylinder", 'CAPSULE'),
-                             ("plane", 'PLANE'), ("grid", 'PLANE'), ("torus", 'TORUS')):
+                             ("cube", 'BOX'), ("plane", 'PLANE'), ("grid", 'PLANE'), ("torus", 'TORUS')):
             if name.startswith(prefix):
                 shape = kind
                 break
         else:
-            raise ShotError(f"{obj.name}: collider shape not detected from its name (choose Sphere, Capsule, Plane or Torus)")
+            raise ShotError(f"{obj.name}: collider shape not detected from its name "
+                            "(choose Sphere, Capsule, Box, Plane or Torus)")
     d = obj.dimensions
-    axis = (obj.matrix_world.to_3x3() @ Vector((0, 0, 1))).normalized()
+    m3 = obj.matrix_world.to_3x3()
+    axis = (m3 @ Vector((0, 0, 1))).normalized()
     c = world_center(obj)
     if shape == 'SPHERE':
         spec = {"type": "sphere", "center": to_keyframe(c), "radius": max(d) / 2}
@@ -158,8 +167,17 @@ def collider_spec(obj):
         radius = max(d.x, d.y) / 2
         half = max(d.z / 2 - radius, 1e-3)
         spec = {"type": "capsule", "a": to_keyframe(c - half * axis), "b": to_keyframe(c + half * axis), "radius": radius}
+    elif shape == 'BOX':
+        # Its local X and Y as keyframe's u_axis and v_axis, made perpendicular in double precision (Blender's
+        # vectors are single; keyframe refuses axes off by more than 1e-6); the third size is along X x Y, its Z.
+        u = unit([float(a) for a in m3 @ Vector((1, 0, 0))])
+        v = [float(a) for a in m3 @ Vector((0, 1, 0))]
+        dot = sum(a * b for a, b in zip(u, v))
+        v = unit([b - dot * a for a, b in zip(u, v)])
+        spec = {"type": "box", "center": to_keyframe(c), "size": [float(d.x), float(d.y), float(d.z)],
+                "u_axis": to_keyframe(u), "v_axis": to_keyframe(v)}
     elif shape == 'PLANE':
-        spec = {"type": "ground", "point": to_keyframe(obj.matrix_world.translation), "normal": to_keyframe(axis)}
+        spec = {"type": "ground", "center": to_keyframe(obj.matrix_world.translation), "axis": to_keyframe(axis)}
     else:
         tube = d.z / 2
         spec = {"type": "torus", "center": to_keyframe(c), "axis": to_keyframe(axis),

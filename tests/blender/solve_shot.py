@@ -4,7 +4,8 @@
 # A subdivided plane hangs from a pin group; an animated Empty is the target of its lower corner; a UV sphere is
 # a collider. Checks: the played-back corner at the keyframe lies within 1 cm of the Empty; the written scene
 # validates against `keyframe schema`; a target out of reach reports the diagnosis (exit 7); Cancel sends
-# SIGINT (exit 6) and the best controls so far play back. Any failed check raises (Blender exits 1).
+# SIGINT (exit 6) and the best controls so far play back; a cube, a plane, a cylinder and a torus are written as
+# keyframe's colliders and load. Any failed check raises (Blender exits 1).
 import json
 import math
 import os
@@ -153,4 +154,38 @@ level, text = keyframe_cloth.finish(scene, solve, code, cloth)
 print("cancel:", code, text)
 assert code == 6, (code, solve.errors)
 assert text.startswith("cancelled"), text
+# 5. Every collider shape: a rotated, scaled cube (a box along its axes), a plane (the ground), a cylinder (a
+# capsule) and a torus, detected from their names, are written in keyframe's frame, validate against the schema
+# and load in keyframe itself (`keyframe inspect SCENE` parses the scene and fills in its defaults).
+bpy.ops.mesh.primitive_cube_add(size=0.2, location=(0.5, 0.3, 0.2), rotation=(0, 0, 0.3), scale=(1, 2, 0.5))
+bpy.ops.mesh.primitive_plane_add(size=2, location=(0, 0, 0.05))
+bpy.ops.mesh.primitive_cylinder_add(radius=0.05, depth=0.5, location=(-0.5, 0, 0.5))
+bpy.ops.mesh.primitive_torus_add(major_radius=0.3, minor_radius=0.05, location=(0, 0.5, 0.1))
+for o in scene.objects:
+    if o.type == 'MESH' and o is not cloth:
+        o.keyframe.role = 'COLLIDER'
+shot_path, _ = keyframe_cloth.write_scene(scene)
+colliders = {c["type"]: c for c in json.load(open(shot_path))["cloth"]["colliders"]}
+assert sorted(colliders) == ["box", "capsule", "ground", "sphere", "torus"], sorted(colliders)
+
+
+def near(a, b, tol=1e-6):
+    return max(abs(x - y) for x, y in zip(a, b)) < tol
+
+
+box, turn = colliders["box"], 0.3
+assert near(box["center"], [0.5, 0.2, -0.3]) and near(box["size"], [0.2, 0.4, 0.1]), box
+assert near(box["u_axis"], [math.cos(turn), 0, -math.sin(turn)]), box
+assert near(box["v_axis"], [-math.sin(turn), 0, -math.cos(turn)]), box
+assert abs(sum(a * b for a, b in zip(box["u_axis"], box["v_axis"]))) < 1e-12, box
+assert near(colliders["ground"]["center"], [0, 0.05, 0]) and near(colliders["ground"]["axis"], [0, 1, 0])
+capsule = colliders["capsule"]
+assert near(capsule["a"], [-0.5, 0.3, 0]) and near(capsule["b"], [-0.5, 0.7, 0]) and abs(capsule["radius"] - 0.05) < 1e-6
+torus = colliders["torus"]
+assert near(torus["center"], [0, 0.1, -0.5]) and abs(torus["radius"] - 0.3) < 1e-6 and abs(torus["tube_radius"] - 0.05) < 1e-6
+ok, why = validates(shot_path)
+assert ok, why
+inspect = subprocess.run([binary, "inspect", shot_path], capture_output=True, text=True)
+assert inspect.returncode == 0, inspect.stdout + inspect.stderr
+print("colliders: box, ground, capsule and torus written, validated and loaded by keyframe")
 print("BLENDER ADD-ON CHECKS PASSED")
