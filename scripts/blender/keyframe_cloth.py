@@ -4,7 +4,9 @@
 # A mesh object becomes the cloth (its vertices the particles, in Blender's order); vertex groups name the pins
 # and the keyframed sets; an Empty's location at a frame is a set's target (its centre of mass, or every vertex
 # carried rigidly by the Empty); spheres, cylinders (as capsules), cubes (as boxes), planes and tori become
-# colliders. The scene
+# colliders. A flock instead: an object marked Flock is where its agents start (their count and spawn radius), and
+# closed curves marked Flock shape are the shapes it fills at their frames (drawn on Blender's ground, XY).
+# The scene
 # is written in keyframe's frame (Y up: Blender's (x, y, z) is keyframe's (x, z, -y)) beside the mesh as OBJ,
 # so the same file runs from the shell or on the farm.
 bl_info = {
@@ -70,7 +72,9 @@ class KeyframeObject(bpy.types.PropertyGroup):
     role: bpy.props.EnumProperty(name="Role", default='NONE', items=[
         ('NONE', "None", "Not part of the shot"),
         ('CLOTH', "Cloth", "This mesh is the cloth"),
-        ('COLLIDER', "Collider", "The cloth is pushed out of this object")])
+        ('COLLIDER', "Collider", "The cloth is pushed out of this object"),
+        ('FLOCK', "Flock", "A flock of agents starts around this object (instead of a cloth)"),
+        ('SHAPE', "Flock shape", "A closed curve the flock fills at a frame")])
     mass: bpy.props.FloatProperty(name="Mass", default=0.5, min=1e-6, unit='MASS', description="Total, kg")
     stretch: bpy.props.FloatProperty(name="Stretch", default=500, min=0, description="N/m")
     shear: bpy.props.FloatProperty(name="Shear", default=50, min=0, description="N/m")
@@ -84,6 +88,12 @@ class KeyframeObject(bpy.types.PropertyGroup):
         ('BOX', "Box", "A cube or cuboid, along the object's axes"),
         ('PLANE', "Plane", "The infinite plane, free side along the object's Z"), ('TORUS', "Torus", "")])
     friction: bpy.props.FloatProperty(name="Friction", default=0, min=0, max=10)
+    agents: bpy.props.IntProperty(name="Agents", default=100, min=1, max=1000000)
+    spawn_radius: bpy.props.FloatProperty(name="Spawn radius", default=8, min=0.01, unit='LENGTH',
+                                          description="The agents start in a disc of this radius on the ground")
+    frame: bpy.props.IntProperty(name="Frame", default=0, min=0, description="The frame the flock fills this shape")
+    coverage: bpy.props.FloatProperty(name="Coverage", default=0.3, min=0,
+                                      description="Weight of filling every part of the shape (0: only inside)")
 
 
 class KeyframeScene(bpy.types.PropertyGroup):
@@ -244,18 +254,68 @@ def shot_directory(scene):
     return os.path.abspath(bpy.path.abspath(d))
 
 
-def write_scene(scene):
-    """Writes DIRECTORY/NAME.json and NAME.obj; returns the scene's path and the cloth object."""
-    cloth, colliders = shot_objects(scene)
-    s, ks = cloth.keyframe, scene.keyframe
+def shape_term(scene, obj):
+    """A Flock shape curve as a shape keyframe: its points flattened to the ground, keyframe's [x, z]."""
+    what = f"{obj.name}: flock shape"
+    if obj.type != 'CURVE' or len(obj.data.splines) != 1 or not obj.data.splines[0].use_cyclic_u:
+        raise ShotError(f"{what}: expected a closed curve of one spline")
+    f = obj.keyframe.frame
+    if not scene.frame_start < f <= scene.frame_end:
+        raise ShotError(f"{what}: frame {f} outside the scene's frames {scene.frame_start + 1}..{scene.frame_end}")
+    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    mesh = evaluated.to_mesh()
+    points = [obj.matrix_world @ v.co for v in mesh.vertices]
+    evaluated.to_mesh_clear()
+    if len(points) < 3:
+        raise ShotError(f"{what}: fewer than 3 points")
+    term = {"type": "shape", "frame": f - scene.frame_start, "polygon": [[p.x, -p.y] for p in points]}
+    if obj.keyframe.coverage > 0:
+        term["coverage"] = {"weight": obj.keyframe.coverage}
+    return term
+
+
+def write_flock_scene(scene, flock, header):
+    """Writes DIRECTORY/NAME.json for a flock; returns the scene's path and the flock object."""
+    if any(o.keyframe.role in ('CLOTH', 'COLLIDER') for o in scene.objects):
+        raise ShotError(f"{flock.name}: a shot is a flock or a cloth (unmark the cloth and its colliders)")
+    terms = [shape_term(scene, o) for o in scene.objects if o.keyframe.role == 'SHAPE']
+    if not terms:
+        raise ShotError(f"{flock.name}: no flock shape (mark a closed curve as Flock shape and give it a frame)")
+    c = to_keyframe(flock.matrix_world.translation)
+    s = flock.keyframe
+    shot = dict(header, flock={"agents": s.agents, "spawn": {"center": [c[0], 0, c[2]], "radius": s.spawn_radius}},
+                objectives=terms)
+    path = os.path.join(shot_directory(scene), safe_name(flock.name) + ".json")
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    write_whole(path, json.dumps(shot, indent=1) + "\n")
+    return path, flock
+
+
+def shot_header(scene):
     frames = scene.frame_end - scene.frame_start
     if frames < 1:
         raise ShotError("the scene needs at least two frames")
+    fps, ks = scene.render.fps / scene.render.fps_base, scene.keyframe
+    return {"time": {"fps": int(fps) if float(fps).is_integer() else fps, "frames": frames},
+            "controls": {"kind": "per_frame"},
+            "optimizer": {"max_evaluations": ks.max_evaluations, "stop_when_reached": ks.stop_when_reached}}
+
+
+def write_scene(scene):
+    """Writes DIRECTORY/NAME.json and NAME.obj; returns the scene's path and the object played back (the cloth,
+    or the flock's)."""
+    header = shot_header(scene)
+    flocks = [o for o in scene.objects if o.keyframe.role == 'FLOCK']
+    if len(flocks) > 1:
+        raise ShotError(f"expected at most one object marked as flock, found {len(flocks)}")
+    if flocks:
+        return write_flock_scene(scene, flocks[0], header)
+    cloth, colliders = shot_objects(scene)
+    s = cloth.keyframe
     name = safe_name(cloth.name)
     directory = shot_directory(scene)
     os.makedirs(directory, exist_ok=True)
     write_obj(os.path.join(directory, name + ".obj"), cloth)
-    fps = scene.render.fps / scene.render.fps_base
     block = {"mesh": {"file": name + ".obj", "up_axis": "z"},
              "mass": s.mass, "stretch": s.stretch, "shear": s.shear, "bend": s.bend, "damping": s.damping}
     if s.pin_group:
@@ -267,9 +327,7 @@ def write_scene(scene):
     terms = objectives(scene, cloth)
     if not terms:
         raise ShotError(f"{cloth.name}: no keyframe (add one: a vertex group and an Empty)")
-    shot = {"time": {"fps": int(fps) if float(fps).is_integer() else fps, "frames": frames},
-            "cloth": block, "objectives": terms, "controls": {"kind": "per_frame"},
-            "optimizer": {"max_evaluations": ks.max_evaluations, "stop_when_reached": ks.stop_when_reached}}
+    shot = dict(header, cloth=block, objectives=terms)
     path = os.path.join(directory, name + ".json")
     write_whole(path, json.dumps(shot, indent=1) + "\n")
     return path, cloth
@@ -350,13 +408,38 @@ def read_pc2(path):
     return points, start, rate, samples, data
 
 
+def agents_object(run_dir, flock):
+    """The flock's agents as a mesh object "FLOCK agents" (replaced on every solve) from the export's rest OBJ,
+    in Blender's axes, at the world origin."""
+    vertices, faces = [], []
+    with open(os.path.join(run_dir, "export", "agents.obj")) as f:
+        for line in f:
+            w = line.split()
+            if w and w[0] == "v":
+                vertices.append(from_keyframe([float(a) for a in w[1:4]]))
+            elif w and w[0] == "f":
+                faces.append([int(a.split("/")[0]) - 1 for a in w[1:]])
+    name = flock.name + " agents"
+    old = bpy.data.objects.get(name)
+    if old is not None:
+        bpy.data.objects.remove(old)
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(vertices, [], faces)
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
+
+
 def play_back(binary, run_dir, cloth):
     """Exports the run as PC2, rewrites it in the object's own space and axes and plays it through a Mesh Cache
-    modifier named "keyframe" from the scene's first frame."""
+    modifier named "keyframe" from the scene's first frame (a flock's on its agents object)."""
     r = subprocess.run([binary, "export", run_dir, "--format", "pc2"], capture_output=True, text=True)
     if r.returncode != 0:
         raise ShotError("keyframe export: " + (r.stderr.strip().splitlines() or ["failed"])[-1])
-    points, start, rate, samples, data = read_pc2(os.path.join(run_dir, "export", "cloth.pc2"))
+    system = "cloth"
+    if cloth.keyframe.role == 'FLOCK':
+        cloth, system = agents_object(run_dir, cloth), "agents"
+    points, start, rate, samples, data = read_pc2(os.path.join(run_dir, "export", system + ".pc2"))
     if points != len(cloth.data.vertices):
         raise ShotError(f"{cloth.name}: the run has {points} particles, the mesh {len(cloth.data.vertices)} vertices")
     to_local = cloth.matrix_world.inverted()
@@ -530,6 +613,12 @@ class KEYFRAME_PT_panel(bpy.types.Panel):
             elif s.role == 'COLLIDER':
                 layout.prop(s, "shape")
                 layout.prop(s, "friction")
+            elif s.role == 'FLOCK':
+                layout.prop(s, "agents")
+                layout.prop(s, "spawn_radius")
+            elif s.role == 'SHAPE':
+                layout.prop(s, "frame")
+                layout.prop(s, "coverage")
         col = layout.column()
         col.prop(ks, "binary")
         col.prop(ks, "directory")

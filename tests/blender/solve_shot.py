@@ -5,7 +5,8 @@
 # a collider. Checks: the played-back corner at the keyframe lies within 1 cm of the Empty; the written scene
 # validates against `keyframe schema`; a target out of reach reports the diagnosis (exit 7); Cancel sends
 # SIGINT (exit 6) and the best controls so far play back; a cube, a plane, a cylinder and a torus are written as
-# keyframe's colliders and load. Any failed check raises (Blender exits 1).
+# keyframe's colliders and load; a flock from an agent count fills a curve drawn in Blender. Any failed check
+# raises (Blender exits 1).
 import json
 import math
 import os
@@ -188,4 +189,48 @@ assert ok, why
 inspect = subprocess.run([binary, "inspect", shot_path], capture_output=True, text=True)
 assert inspect.returncode == 0, inspect.stdout + inspect.stderr
 print("colliders: box, ground, capsule and torus written, validated and loaded by keyframe")
+# 6. A flock: 30 agents start around an Empty marked Flock, and fill a closed Bezier circle (radius 2.5 m, 3 m
+# along -Y) marked Flock shape at frame 49 (2 s). Solve; keyframe's own measure has at least 95 % of them
+# inside; the agents play back on their own object, every agent's arrowhead (its 12 vertices' mean, a few cm
+# behind the agent) within the circle grown by 10 cm at frame 49, and most of them outside it at frame 1.
+for o in scene.objects:
+    o.keyframe.role = 'NONE'
+scene.frame_end = 49
+bpy.ops.object.empty_add(location=(0, 0, 0))
+flock = bpy.context.object
+flock.name = "Flock"
+flock.keyframe.role = 'FLOCK'
+flock.keyframe.agents, flock.keyframe.spawn_radius = 30, 3
+bpy.ops.curve.primitive_bezier_circle_add(radius=2.5, location=(0, -3, 0))
+circle = bpy.context.object
+circle.keyframe.role, circle.keyframe.frame = 'SHAPE', 49
+scene.keyframe.max_evaluations = 300
+started = time.time()
+assert bpy.ops.keyframe.solve(wait=True) == {'FINISHED'}, scene.keyframe.status
+flock_path = os.path.join(work, "Flock.json")
+flock_shot = json.load(open(flock_path))
+ok, why = validates(flock_path)
+assert ok, why
+polygon = flock_shot["objectives"][0]["polygon"]
+assert flock_shot["objectives"][0]["frame"] == 48 and len(polygon) >= 12, flock_shot["objectives"]
+assert all(abs(math.hypot(x, z - 3) - 2.5) < 1e-3 for x, z in polygon), polygon  # Blender -Y is keyframe +z
+measures = json.load(open(os.path.join(work, "Flock-run", "report.json")))["measures"]
+assert measures[0]["inside_fraction"] >= 0.95, measures
+agents = bpy.data.objects["Flock agents"]
+assert agents.modifiers["keyframe"].type == 'MESH_CACHE'
+
+
+def agents_in_circle(frame, grown):
+    scene.frame_set(frame)
+    ev = agents.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    points = [agents.matrix_world @ v.co for v in ev.data.vertices]
+    assert len(points) == 30 * 12, len(points)  # each agent an arrowhead of 12 vertices (keyframe export)
+    centres = [sum(points[12 * k:12 * k + 12], type(points[0])()) / 12 for k in range(30)]
+    return sum(math.hypot(c.x, c.y + 3) < 2.5 + grown for c in centres)
+
+
+at_shape, at_start = agents_in_circle(49, 0.1), agents_in_circle(1, 0.1)
+print(f"flock: {time.time() - started:.1f} s; inside fraction {measures[0]['inside_fraction']:.3f}; played back "
+      f"{at_shape} of 30 agents in the circle at frame 49, {at_start} at frame 1; {scene.keyframe.status}")
+assert at_shape == 30 and at_start <= 20, (at_shape, at_start)
 print("BLENDER ADD-ON CHECKS PASSED")
