@@ -132,6 +132,7 @@ struct KeyNode {
   std::vector<ParamRead> reads;
   std::set<std::string> instances;    // "log#pointer" of each object this node was, where keys were read below it
   std::set<std::string> required_in;  // "log#pointer" of each parent object that read this key as required
+  std::set<std::string> read_in;      // "log#pointer" of each parent object that read this key
   std::map<std::string, KeyNode> keys;
 };
 
@@ -158,6 +159,7 @@ void insert(KeyNode& root, const ParamRead& r, size_t log) {
       continue;
     }
     node->reads.push_back(r);
+    node->read_in.insert(tag + parent);
     if (r.required) node->required_in.insert(tag + parent);
   }
 }
@@ -233,19 +235,43 @@ Json key_schema(const KeyNode& n) {
   return {{"anyOf", any}};
 }
 
-Json object_schema(const KeyNode& n) {
+// One form of an object: the keys `form` (all of n's when empty), each required where every read of it was and
+// every object in `instances` read it as required.
+Json form_schema(const KeyNode& n, const std::set<std::string>& form, const std::set<std::string>& instances) {
   Json s = {{"type", "object"}, {"additionalProperties", false}};
   Json properties = Json::object(), required = Json::array();
   for (const auto& [key, child] : n.keys) {
-    if (key == "*" || child.reads.empty()) continue;
+    if (key == "*" || child.reads.empty() || (!form.empty() && !form.count(key))) continue;
     properties[key] = key_schema(child);
     const bool always_required = std::all_of(child.reads.begin(), child.reads.end(),
                                              [](const ParamRead& r) { return r.required; });
-    if (always_required && child.required_in == n.instances) required.push_back(key);
+    const bool everywhere = std::includes(child.required_in.begin(), child.required_in.end(), instances.begin(),
+                                          instances.end());
+    if (always_required && everywhere) required.push_back(key);
   }
   s["properties"] = properties;
   if (!required.empty()) s["required"] = required;
   return s;
+}
+
+// An object the parser reads in alternative forms that share no key (a selector: {"group"}, or "min" with
+// "max", or grid rows and columns) is anyOf its forms, so keys of two forms together, or a form missing a key
+// it requires, do not validate; any other object is one form of every key read in it.
+Json object_schema(const KeyNode& n) {
+  std::map<std::string, std::set<std::string>> keys_of;  // each object read here → the keys read in it
+  for (const auto& [key, child] : n.keys)
+    if (key != "*" && !child.reads.empty())
+      for (const std::string& parent : child.read_in) keys_of[parent].insert(key);
+  std::map<std::set<std::string>, std::set<std::string>> forms;  // keys → the objects that read exactly them
+  for (const auto& [parent, keys] : keys_of) forms[keys].insert(parent);
+  bool disjoint = forms.size() >= 2;
+  std::set<std::string> seen;
+  for (const auto& [keys, parents] : forms)
+    for (const std::string& k : keys) disjoint = disjoint && seen.insert(k).second;
+  if (!disjoint) return form_schema(n, {}, n.instances);
+  Json any = Json::array();
+  for (const auto& [keys, parents] : forms) any.push_back(form_schema(n, keys, parents));
+  return {{"anyOf", any}};
 }
 
 }  // namespace

@@ -200,6 +200,47 @@ TEST_F(SceneSchema, RejectsWhatTheParserRejects) {
   EXPECT_THROW(parse_scene(missing.dump(), "bad.json"), InputError);
 }
 
+// A mesh cloth's selectors come in forms that do not mix: a named set {"group"}, a rest-space box with both
+// "min" and "max", or (keyframe particles) grid rows and columns; a hole is a polygon or a circle. What mixes
+// two forms, or leaves out a key its form requires, does not validate, and the parser refuses it too.
+TEST_F(SceneSchema, SelectorFormsDoNotMix) {
+  const Json good = Json::parse(read_text(kSource / "scenes/robustness/poncho.json"));
+  ASSERT_TRUE(problems_of(good, committed_).empty());
+  const Json box = good["cloth"]["pins"];
+  struct Case {
+    const char* pointer;
+    Json value;
+  };
+  const std::vector<Case> cases = {
+      {"/cloth/pins", Json{{"group", "collar"}, {"min", box["min"]}, {"max", box["max"]}}},
+      {"/cloth/pins", Json{{"min", box["min"]}}},
+      {"/cloth/pins", Json::object()},
+      {"/objectives/0/particles", Json{{"group", "hem"}, {"row", 0}}},
+      {"/objectives/0/particles", Json{{"max", box["max"]}, {"column", 1}}},
+      {"/objectives/0/particles", Json{{"min", box["min"]}, {"max", box["max"]}, {"u", {0, 1}}}},
+  };
+  for (const Case& c : cases) {
+    Json bad = good;
+    bad[Json::json_pointer(c.pointer)] = c.value;
+    const auto problems = problems_of(bad, committed_);
+    ASSERT_EQ(problems.size(), 1u) << c.pointer << " " << c.value.dump();
+    EXPECT_EQ(problems.front(), std::string(c.pointer) + ": matches none of anyOf") << c.value.dump();
+    EXPECT_THROW(parse_scene(bad.dump(), kSource / "scenes/robustness/poncho.json"), InputError) << c.value.dump();
+  }
+  // Each form alone still validates.
+  for (const Json& form : {Json{{"group", "collar"}}, box}) {
+    Json ok = good;
+    ok["cloth"]["pins"] = form;
+    EXPECT_TRUE(problems_of(ok, committed_).empty()) << form.dump();
+  }
+  const Json flock = Json::parse(read_text(kSource / "scenes/robustness/flock-arrow.json"));
+  Json both = flock;
+  both["objectives"][0]["holes"] =
+      Json::array({Json{{"polygon", {{-1, 5}, {1, 5}, {0, 6}}}, {"circle", {{"center", {0, 8}}, {"radius", 0.5}}}}});
+  EXPECT_EQ(problems_of(both, committed_), std::vector<std::string>{"/objectives/0/holes/0: matches none of anyOf"});
+  EXPECT_THROW(parse_scene(both.dump(), kSource / "scenes/robustness/flock-arrow.json"), InputError);
+}
+
 // The schema states the parser's rule of exactly one system.
 TEST_F(SceneSchema, StatesExactlyOneOfFlockAndCloth) {
   const Json flock = Json::parse(read_text(kSource / "scenes/square.json"));
