@@ -14,6 +14,7 @@
 #include "opt/problem.h"
 #include "scene/cloth_mesh.h"
 #include "scene/cloth_mesh_spec.h"
+#include "sim/cape/self_collider.h"
 #include "sim/cloth/cloth_springs.h"
 #include "sim/cloth/cloth_terms.h"
 #include "sim/cloth/mesh_layout.h"
@@ -177,6 +178,46 @@ TEST(ClothMeshForces, EveryTermMatchesFiniteDifferencesCompressedStretchedAndInC
     }
 }
 
+// Self contact reports no energy (a pair's force is gathered per particle; collider.h): the same term with
+// the energy check left out, its force, definite blocks and adjoint shares checked.
+class PairContactTerm : public ContactTerm {
+ public:
+  using ContactTerm::ContactTerm;
+  static constexpr double ClothEnergy::*kEnergy = nullptr;
+};
+
+// Self contact (`cloth.self`'s term, particle pairs) on the irregular patch folded over, its two layers 6 mm
+// apart with each upper vertex about 7 mm from its lower twin, sliding across each other: the pair forces with
+// their cross couplings and the pair friction, against central differences at two step sizes, squeezed and
+// stretched.
+TEST(ClothMeshForces, SelfContactOfAFoldedIrregularMeshMatchesFiniteDifferences) {
+  test::MeshDir dir;
+  const auto file = test::write_folded_irregular_obj(dir.path(), Vec3(0, 0.02, 0), 0.3, 0.006, Vec3(0.003, 0, 0.002));
+  const std::string cloth = R"({"mesh": {"file": ")" + file.string() + R"("}, "mass": 0.1})";
+  for (double squeeze : {0.97, 1.03})
+    for (double speed : {1e-4, 0.3}) {
+      SCOPED_TRACE("squeeze " + std::to_string(squeeze) + " speed " + std::to_string(speed));
+      auto sheet = test::term_sheet(cloth);
+      ASSERT_EQ(sheet->particles(), 70);  // each layer's notch corner is in no face
+      auto self = std::make_unique<SelfCollider>(sheet->particles(), 0.01, 500.0, 0.5 * 0.01);
+      self->set_friction({0.3, 0.01});
+      SelfCollider* pairs = self.get();
+      sheet->colliders.push_back(std::move(self));
+      sheet->prepare = [pairs](const VecX& x, const VecX& v) { pairs->update(x, v); };
+      VecX x, v;
+      test::perturbed_state(*sheet, squeeze, 0.0005, speed, 17, x, v);
+      pairs->set_counting(true);
+      const test::TermCheck contact = test::check_term(test::TermProbe<PairContactTerm>(*sheet), x, v, 18);
+      EXPECT_GT(pairs->take_count(), 0) << "no pair in contact";
+      EXPECT_GT(contact.force, 0);
+      EXPECT_GT(contact.adjoint_x, 0);
+      const test::TermCheck friction = test::check_term(test::TermProbe<FrictionTerm>(*sheet), x, v, 19);
+      EXPECT_GT(friction.force, 0) << "no pair friction";
+      EXPECT_GT(friction.adjoint_x, 0);
+      EXPECT_GT(friction.adjoint_v, 0);
+    }
+}
+
 // The whole step's exact adjoint (keyframe gradcheck) on the irregular patch, pinned by a region, lying on a
 // sphere and sliding on the ground, at zero and perturbed controls, per-step forces and the 3 x 3 lattice.
 TEST(ClothMeshAdjoint, MatchesFiniteDifferencesInContactAtPerturbedControls) {
@@ -220,6 +261,52 @@ TEST(ClothMeshAdjoint, MatchesFiniteDifferencesInContactAtPerturbedControls) {
       });
     }
   }
+}
+
+// The folded irregular mesh lying on the ground with friction, pinned at one corner region of its lower layer;
+// `self` is the scene's cloth.self block.
+Scene folded_scene(const std::filesystem::path& dir, const std::filesystem::path& file, const char* controls,
+                   int substeps, const std::string& self) {
+  return parse_scene(
+      std::string(R"({"time": {"fps": 30, "frames": 3, "substeps": )") + std::to_string(substeps) +
+          R"(}, "cloth": {"mesh": {"file": ")" + file.string() + R"("}, "mass": 0.1, "solver": "direct",
+          "velocity": [0.6, 0, 0.2], "pins": {"min": [-1, -1, -1], "max": [-0.1, 0.015, -0.1]}, "self": )" + self + R"(,
+          "colliders": [{"type": "ground", "thickness": 0.015, "stiffness": 3000, "friction": 0.5}]},
+          "controls": )" + controls + R"(,
+          "objectives": [{"type": "position", "frame": 3, "weight": 100,
+                          "particles": {"min": [-1, 0.015, -1], "max": [1, 1, 1]}, "targets": [[0.05, 0.03, 0]]}]})",
+      dir / "folded.json");
+}
+
+// The whole step's exact adjoint with `cloth.self` on the folded irregular mesh: the upper layer slides over
+// the lower (pair contact and pair friction from the first step: the scene's objective differs without them),
+// per-step and per-frame forces at zero and perturbed controls.
+TEST(ClothMeshAdjoint, SelfContactOfAFoldedMeshMatchesFiniteDifferences) {
+  test::MeshDir dir;
+  const auto file = test::write_folded_irregular_obj(dir.path(), Vec3(0, 0.012, 0), 0.3, 0.007, Vec3(0.003, 0, 0.002));
+  const std::string self = R"({"enabled": true, "thickness": 0.01, "stiffness": 500, "friction": 0.3})";
+  for (const char* controls : {R"({"kind": "per_step", "alpha": 1e-4})", R"({"kind": "per_frame", "alpha": 1e-4})"})
+    for (int substeps : {1, 4}) {
+      const Scene scene = folded_scene(dir.path(), file, controls, substeps, self);
+      auto sys = make_system(scene);
+      Problem problem(scene, scene.time, *sys);
+      {
+        const Scene apart = folded_scene(dir.path(), file, controls, substeps, R"({"enabled": false})");
+        auto apart_sys = make_system(apart);
+        Problem apart_problem(apart, apart.time, *apart_sys);
+        const VecX z = problem.initial_guess();
+        const double with = problem.evaluate(z, nullptr), without = apart_problem.evaluate(z, nullptr);
+        EXPECT_GT(std::abs(with - without), 1e-3 * std::abs(without)) << "the layers never touched";
+      }
+      test::gradcheck_perturbed(problem, 1e-4, {0.0, 0.01, 0.1}, [&](double perturb, const GradcheckResult& r) {
+        std::printf("folded self contact %s h = 1/%d, perturb %g: max_rel_error %.2e, fd_spread %.2e, %d checked\n",
+                    controls, 30 * substeps, perturb, r.max_rel_error, r.fd_spread, r.checked);
+        ASSERT_GT(r.grad_norm, 0);
+        EXPECT_GE(r.checked, 14);
+        EXPECT_LE(r.fd_spread, 1e-6) << "the differences' steps disagree";
+        EXPECT_LE(r.max_rel_error, 1e-6) << controls << " h = 1/" << 30 * substeps << " perturb " << perturb;
+      });
+    }
 }
 
 // Runs `steps` steps of the scene's cloth from its start with no control; the positions after each.

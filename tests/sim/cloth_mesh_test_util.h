@@ -65,18 +65,17 @@ inline std::filesystem::path write_grid_obj(const std::filesystem::path& dir, co
 
 // An irregular patch of side `side` centred on `center` in the x-z plane: a 6 x 6 lattice jittered by up to
 // 15 % of its spacing, one interior cell left out (a hole), one corner cell left out (a notch), cells split
-// into triangles along alternating diagonals where (i + j) % 3 == 0, quads elsewhere.
-inline std::filesystem::path write_irregular_obj(const std::filesystem::path& dir, const Vec3& center, double side) {
+// into triangles along alternating diagonals where (i + j) % 3 == 0, quads elsewhere. Vertex ids from `first`.
+inline void irregular_patch(const Vec3& center, double side, int first, std::vector<Vec3>& v,
+                            std::vector<std::vector<int>>& faces) {
   constexpr int n = 6;
   const double d = side / (n - 1);
   std::mt19937 rng(42);
   std::uniform_real_distribution<double> U(-0.15 * d, 0.15 * d);
-  std::vector<Vec3> v;
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i)
       v.push_back(center + Vec3(-0.5 * side + i * d + U(rng), 0, -0.5 * side + j * d + U(rng)));
-  std::vector<std::vector<int>> faces;
-  auto id = [](int i, int j) { return j * n + i; };
+  auto id = [first](int i, int j) { return first + j * n + i; };
   for (int j = 0; j + 1 < n; ++j)
     for (int i = 0; i + 1 < n; ++i) {
       if ((i == 2 && j == 2) || (i == n - 2 && j == n - 2)) continue;
@@ -85,7 +84,28 @@ inline std::filesystem::path write_irregular_obj(const std::filesystem::path& di
       else if ((i + j) % 2 == 0) faces.insert(faces.end(), {{a, b, c}, {a, c, e}});
       else faces.insert(faces.end(), {{a, b, e}, {b, c, e}});
     }
+}
+
+inline std::filesystem::path write_irregular_obj(const std::filesystem::path& dir, const Vec3& center, double side) {
+  std::vector<Vec3> v;
+  std::vector<std::vector<int>> faces;
+  irregular_patch(center, side, 0, v, faces);
   const auto file = dir / "irregular.obj";
+  write_obj(file, v, faces);
+  return file;
+}
+
+// The irregular patch folded over: a second copy `gap` above the first, shifted by `shift` in the plane,
+// joined to it along the patch's j = 0 edge by a strip of quads (the fold), so the mesh is one piece whose
+// two layers lie closer than a self-contact thickness above `gap`. 72 vertices.
+inline std::filesystem::path write_folded_irregular_obj(const std::filesystem::path& dir, const Vec3& center,
+                                                        double side, double gap, const Vec3& shift) {
+  std::vector<Vec3> v;
+  std::vector<std::vector<int>> faces;
+  irregular_patch(center, side, 0, v, faces);
+  irregular_patch(center + Vec3(0, gap, 0) + shift, side, 36, v, faces);
+  for (int i = 0; i + 1 < 6; ++i) faces.push_back({i, i + 1, 36 + i + 1, 36 + i});
+  const auto file = dir / "folded.obj";
   write_obj(file, v, faces);
   return file;
 }
