@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include "core/ground_region.h"
+
 #include "opt/objective_terms.h"
 
 namespace kf {
