@@ -19,6 +19,7 @@ import bmesh
 import bpy
 import jsonschema  # Debian's python3-jsonschema, which Blender's Python reads
 
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts", "blender"))
 import keyframe_cloth  # noqa: E402
 
