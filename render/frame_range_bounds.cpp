@@ -28,6 +28,7 @@ Bounds frame_range_bounds(const Scene& scene, const Trajectory& traj, const Mesh
                    [&](const ShapeKeyframe& k) { for (const Vec2& q : k.polygon) b.add(Vec3(q.x(), 0.0, q.y())); },
                    [](const VelocityKeyframe&) {},  // a velocity is no place
                    [](const ArchKeyframe&) {},
+                   [](const HeightKeyframe&) {},  // a height alone is no point in space
                },
                o.kind);
   }
