@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/optimize_job.h"
+#include "../reliability/cli_harness.h"
 #include "../sim/character_test_util.h"
 
 namespace kf {
@@ -102,10 +103,15 @@ TEST(Robustness, TableclothOnATableHangsACornerAtItsMark) {
 }
 
 // A cape hung by anchors on a Z-up Blender figure in its own units (BLEND/HUMAN.blend, scale 0.17, up_axis
-// "z"), its hem's centre lifted and swung back from where it hangs unaided ("from": "uncontrolled").
+// "z"), its hem's centre lifted and swung back from where it hangs unaided ("from": "uncontrolled"). Through
+// the binary: building this figure's ray-tracing hierarchy in the library trips the tests' floating-point traps.
 TEST(Robustness, CapeOnAZUpBlenderFigureLiftsItsHemFromWhereItHangs) {
   test::TempDir dir;
-  const json report = optimise(suite_scene("cape-human-blend"), dir.path());
+  std::ofstream(dir.path() / "scene.json") << suite_scene("cape-human-blend").dump(1);
+  const auto r = reliability::run_keyframe("optimize scene.json --out run", dir.path());
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream in(dir.path() / "run" / "report.json");
+  const json report = json::parse(in);
   expect_every_keyframe_met(report);
   // Unaided, the hem misses by the offset itself: [0, 0.1, -0.2] m, 22.4 cm, in tolerances of 1 cm.
   EXPECT_NEAR(report.at("keyframe_errors")[0].at("miss_before").get<double>(), 100 * std::sqrt(0.05), 1e-4);
