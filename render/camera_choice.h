@@ -4,6 +4,7 @@
 // (toward the viewer), so a polygon written counter-clockwise in (x, z) reads clockwise from above.
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "core/types.h"
 #include "scene/render_spec.h"
@@ -15,7 +16,10 @@ enum class NamedView { kFront, kSide, kTop, kThreeQuarter };
 struct CameraChoice {
   std::optional<NamedView> view;     // framed automatically from this direction
   std::optional<CameraSpec> camera;  // eye and target as given; fov <= 0: the scene's render.fov
-  bool empty() const { return !view && !camera; }
+  // --view-frames A:B: the automatic framing covers frames A..B-1 only (B = -1: to the end), instead of
+  // the whole run and the scene's camera (render/frame_range_bounds.h).
+  std::optional<std::pair<int, int>> frames;
+  bool empty() const { return !view && !camera && !frames; }
 };
 
 // "front|side|top|three-quarter" (the names, for help texts).

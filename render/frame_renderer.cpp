@@ -5,6 +5,7 @@
 #include "core/error.h"
 #include "core/file_name.h"
 #include "core/overloaded.h"
+#include "render/frame_range_bounds.h"
 #include "scene/run_name.h"
 
 namespace kf::render {
@@ -52,7 +53,16 @@ FrameRenderer::FrameRenderer(const RunData& run, const std::string& backend, Ren
                                                   [](const FlockSpec&) { return true; },  // seen from above
                                                   [](const ClothSpec&) { return false; },
                                               });
-  camera_ = make_camera(run.scene.render, bounds_, planar, settings_.width, settings_.height, choice);
+  if (!choice.frames) {
+    camera_ = make_camera(run.scene.render, bounds_, planar, settings_.width, settings_.height, choice);
+    return;
+  }
+  // A range of frames is framed automatically: the scene's own camera does not follow it.
+  RenderSpec framing = run.scene.render;
+  framing.has_camera = false;
+  const Bounds range = frame_range_bounds(run.scene, run.trajectory, run.meshes ? &*run.meshes : nullptr,
+                                          choice.frames->first, choice.frames->second);
+  camera_ = make_camera(framing, range, planar, settings_.width, settings_.height, choice);
 }
 
 Image FrameRenderer::render(int frame, double orbit) {

@@ -2,6 +2,7 @@
 
 #include <iterator>
 
+#include "app/cli_ranges.h"
 #include "core/error.h"
 
 namespace kf {
@@ -14,6 +15,10 @@ void add_camera_options(CLI::App* sub, CameraWords& words) {
   sub->add_option("--view", words.view,
                   "a named view framing the whole scene (every particle, keyframe target and collider): " +
                       render::named_view_names() + "; from top, x runs right and z down the image");
+  sub->add_option("--view-frames", words.view_frames,
+                  "A:B: the automatic camera (or --view's) frames what frames A..B-1 show (the particles, a "
+                  "character, the targets of keyframes among them) instead of the whole run; A: frames A "
+                  "to the end. The ground and the scene's camera are not used for it");
 }
 
 std::vector<std::string> positionals_after_camera(CameraWords& words) {
@@ -39,7 +44,16 @@ render::CameraChoice camera_choice(const CameraWords& words) {
                      std::to_string(words.camera.size()));
   std::string camera;
   for (const auto& w : words.camera) camera += (camera.empty() ? "" : " ") + w;
-  return render::parse_camera_choice(camera, words.view);
+  render::CameraChoice choice = render::parse_camera_choice(camera, words.view);
+  if (!words.view_frames.empty()) {
+    if (choice.camera)
+      throw InputError("--camera and --view-frames exclude each other: --view-frames frames the automatic camera "
+                       "(give --view for its direction)");
+    int begin = 0, end = -1;
+    parse_frames(words.view_frames, begin, end, "--view-frames");
+    choice.frames = std::make_pair(begin, end);
+  }
+  return choice;
 }
 
 }  // namespace kf

@@ -13,9 +13,10 @@ namespace kf {
 struct CameraWords {
   std::vector<std::string> camera;  // --camera's words (quoted as one or given as up to three)
   std::string view;                 // --view
+  std::string view_frames;          // --view-frames
 };
 
-// Adds --camera and --view to `sub`, writing into `words`.
+// Adds --camera, --view and --view-frames to `sub`, writing into `words`.
 void add_camera_options(CLI::App* sub, CameraWords& words);
 
 // --camera takes every word up to the next option (CLI11 cannot stop at three), so the positional arguments

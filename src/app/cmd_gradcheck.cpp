@@ -6,6 +6,7 @@
 #include <random>
 
 #include "app/commands.h"
+#include "app/uncontrolled_targets.h"
 #include "core/error.h"
 #include "core/file_name.h"
 #include "core/warnings.h"
@@ -42,6 +43,7 @@ Scene gradcheck_scene(const GradcheckCommandOptions& o) {
                        std::to_string(scene.time.fps) + " s");
     scene.time.substeps = int(std::round(n));
   }
+  resolve_uncontrolled_offsets(scene);
   return scene;
 }
 

@@ -8,6 +8,7 @@
 #include "app/body_meshes.h"
 #include "app/memory_budget.h"
 #include "app/run_dir.h"
+#include "app/uncontrolled_targets.h"
 #include "core/error.h"
 #include "core/progress.h"
 #include "core/trajectory.h"
@@ -45,6 +46,9 @@ void add_simulate_command(CLI::App& app) {
                   "it: a run estimated to need more is refused up front");
   sub->callback([=] {
     Scene scene = load_scene(*scene_path);
+    // Targets off the uncontrolled motion come from the model an optimisation runs, before the tolerance
+    // changes below.
+    resolve_uncontrolled_offsets(scene);
     if (scene.cloth) scene.cloth->use_motion_tolerance();
     // Before the system is built: a run too large to hold is refused at once.
     check_memory(scene, simulate_memory(scene), max_memory->empty() ? 0 : parse_memory_size(*max_memory));

@@ -12,6 +12,7 @@
 #include "app/memory_budget.h"
 #include "app/optimize_report.h"
 #include "app/run_dir.h"
+#include "app/uncontrolled_targets.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/warnings.h"
@@ -74,6 +75,7 @@ Scene job_scene(const fs::path& scene_file, const OptimizeOptions& opt) {
   if (!opt.adjoint.empty()) scene.optimizer.adjoint = opt.adjoint;
   if (opt.max_seconds >= 0) scene.optimizer.max_seconds = opt.max_seconds;
   if (opt.stop_when_reached >= 0) scene.optimizer.stop_when_reached = opt.stop_when_reached > 0;
+  resolve_uncontrolled_offsets(scene);
   for (const std::string& w : unreachable_keyframes(scene)) warn(w);
   return scene;
 }

@@ -3,6 +3,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "app/uncontrolled_targets.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/file_name.h"
@@ -51,6 +52,7 @@ void prepare_run_dir(const fs::path& dir, const Scene& scene) {
   auto j = nlohmann::json::parse(os.str());
   // The copy names assets absolutely so it reads the same from the run directory (render, resume).
   absolutise_scene_paths(j, scene.directory);
+  write_resolved_targets(j, scene);
   write_file_atomic(dir / "scene.json", j.dump(2) + "\n");
   write_file_atomic(dir / "scene_name.txt", scene.name + "\n" + fs::absolute(scene.directory.empty() ? fs::path(".") : scene.directory).string() + "\n");
 }

@@ -44,12 +44,24 @@ std::vector<int> selected(const ObjectiveSpec& o, int particles) {
   return all;
 }
 
+// A flock's agents stay on the ground, so an offset from where they would be cannot leave it.
+void check_offsets_along_ground(Block& b, const Scene& s, bool rigid, const std::vector<Vec3>& offsets) {
+  if (!s.flock) return;
+  for (size_t k = 0; k < offsets.size(); ++k)
+    if (std::abs(offsets[k].y()) > 1e-9)
+      b.fail_rel(rigid ? "/offset" : "/offset/" + std::to_string(k),
+                 "expected an offset along the ground, dy = 0 (a flock moves on the ground and cannot move by dy = " +
+                     Json(offsets[k].y()).dump() + ")");
+}
+
 // "offset" (one for the whole set, or one per particle) from each particle's place on the rest sheet
-// ("from": "rest", the cloth block's layout), instead of absolute "targets".
+// ("from": "rest", the cloth block's layout), instead of absolute "targets"; or from where it is at the
+// keyframe without controls ("from": "uncontrolled": the offsets stay the targets until a job resolves them,
+// app/uncontrolled_targets.h).
 std::vector<Vec3> offsets_from_rest(Block& b, const std::vector<int>& set, const Scene& s) {
   if (b.has("targets")) b.fail("offset", "expected either \"targets\" or \"offset\", not both");
-  b.string("from", "rest", {"rest"});
-  if (!s.cloth)
+  const bool uncontrolled = b.string("from", "rest", {"rest", "uncontrolled"}) == "uncontrolled";
+  if (!s.cloth && !uncontrolled)
     b.fail("offset", "expected absolute \"targets\": an offset from the rest position needs a cloth (a flock's "
                      "agents start at seeded random places)");
   // [dx, dy, dz]: the whole set moved rigidly; [[dx, dy, dz], ...]: one per particle.
@@ -59,6 +71,10 @@ std::vector<Vec3> offsets_from_rest(Block& b, const std::vector<int>& set, const
   if (offsets.size() != 1 && offsets.size() != set.size())
     b.fail("offset", "expected [dx, dy, dz] (the whole set moved rigidly) or one offset per particle (" +
                          std::to_string(set.size()) + "), got " + std::to_string(offsets.size()));
+  if (uncontrolled) {
+    check_offsets_along_ground(b, s, rigid, offsets);
+    return offsets;
+  }
   std::vector<Vec3> targets;
   for (size_t k = 0; k < set.size(); ++k)
     targets.push_back(rest_position(*s.cloth, set[k]) + offsets[offsets.size() == 1 ? 0 : k]);
@@ -103,7 +119,11 @@ ObjectiveKind parse_center_of_mass(Block& b, const ObjectiveSpec& o, const Scene
     return CenterOfMassKeyframe{target};
   }
   if (b.has("target")) b.fail("offset", "expected either \"target\" or \"offset\", not both");
-  b.string("from", "rest", {"rest"});
+  if (b.string("from", "rest", {"rest", "uncontrolled"}) == "uncontrolled") {
+    const Vec3 offset = b.vec3("offset");  // resolved by a job's uncontrolled simulation
+    check_offsets_along_ground(b, s, true, {offset});
+    return CenterOfMassKeyframe{offset};
+  }
   if (!s.cloth)
     b.fail("offset", "expected an absolute \"target\": an offset from the rest position needs a cloth");
   const std::vector<int> set = selected(o, s.particles());
