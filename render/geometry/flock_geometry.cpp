@@ -107,6 +107,7 @@ void build_flock(const Scene& scene, const Trajectory& traj, int f, double scale
                    },
                    [](const VelocityKeyframe&) {},  // not drawn
                    [](const ArchKeyframe&) {},      // cloth only
+                   [](const HeightKeyframe&) {},    // cloth only
                },
                o.kind);
   }

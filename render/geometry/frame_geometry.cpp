@@ -99,6 +99,7 @@ Bounds scene_bounds(const Scene& scene, const Trajectory& traj, const MeshSequen
                    [&](const CenterOfMassKeyframe& k) { b.add(k.target); },
                    [&](const ShapeKeyframe& k) { for (const Vec2& q : k.polygon) b.add(Vec3(q.x(), 0.0, q.y())); },
                    [](const ArchKeyframe&) {},
+                   [](const HeightKeyframe&) {},  // a height alone is no point in space
                },
                o.kind);
   if (scene.cloth)

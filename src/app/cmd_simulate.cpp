@@ -65,8 +65,9 @@ void add_simulate_command(CLI::App& app) {
     const Trajectory frames = frames_of(r, scene.time, sys->particles());
     // The dry run's measures: how far the uncontrolled motion misses each keyframe, judged as optimize
     // judges its result, so a keyframe can be weighed before a long optimisation.
-    const nlohmann::json measures = figure_measures(scene, frames);
-    const std::vector<KeyframeJudgement> keyframes = judge_keyframes(scene, measures, measures);
+    const std::vector<KeyframeMeasure> keyframe_measures = measure_keyframes(scene, frames);
+    const nlohmann::json measures = figure_measures(scene, frames, keyframe_measures);
+    const std::vector<KeyframeJudgement> keyframes = judge_keyframes(scene, keyframe_measures, keyframe_measures);
     commit_run_dir(staged, [&](const fs::path& work) {
       prepare_run_dir(work, scene);
       save_trajectory(work / "trajectory.bin", frames);

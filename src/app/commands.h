@@ -3,6 +3,8 @@
 #include <CLI/CLI.hpp>
 #include <stdexcept>
 
+#include "core/error.h"  // the exit codes (one table for all commands)
+
 namespace kf {
 
 // Thrown by a subcommand that is not available yet; exits with kExitNotReady.

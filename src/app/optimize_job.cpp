@@ -19,7 +19,7 @@
 #include "opt/evaluation_tape.h"
 #include "opt/strategy.h"
 #include "opt/windows.h"
-#include "scene/reach_check.h"
+#include "opt/keyframes/keyframe_reach.h"
 #include "sim/make_system.h"
 
 namespace kf {

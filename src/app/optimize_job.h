@@ -3,6 +3,8 @@
 #include <filesystem>
 #include <string>
 
+#include "core/error.h"  // kExitNotReached, kExitInterrupted: the exit codes these functions end with
+
 namespace CLI {
 class App;
 }
@@ -37,9 +39,6 @@ OptimizeOutcome optimize_job(const std::filesystem::path& scene_file, const Opti
 void add_optimize_options(CLI::App* sub, OptimizeOptions& o);
 // Exits with kExitInterrupted when the job was stopped by a signal (after it saved its run directory).
 void exit_if_interrupted(const OptimizeOutcome& r);
-// Exit code of optimize and run when the keyframes were not reached (no progress, or far from a target); the
-// run directory is written and report.json says why. Beside the others in core/error.h (README.md lists all).
-constexpr int kExitNotReached = 7;
 // Prints the diagnosis and exits with kExitNotReached when the keyframes were not reached.
 void exit_if_failed(const OptimizeOutcome& r);
 

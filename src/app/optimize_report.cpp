@@ -12,6 +12,7 @@
 #include "core/atomic_file.h"
 #include "core/trajectory.h"
 #include "opt/controls_file.h"
+#include "report/cape_end_state.h"
 #include "report/figure_measures.h"
 #include "report/plot.h"
 
@@ -73,7 +74,7 @@ struct UncontrolledRun {
   double keyframes = 0;  // the keyframe terms of φ (all of φ if it diverged)
   Trajectory frames;
   nlohmann::json stats;
-  nlohmann::json measures;
+  std::vector<KeyframeMeasure> measures;
 };
 
 UncontrolledRun run_uncontrolled(const Scene& scene, StrategyResult& job) {
@@ -83,7 +84,7 @@ UncontrolledRun run_uncontrolled(const Scene& scene, StrategyResult& job) {
   u.keyframes = problem.last_diverged() ? objective : keyframe_terms(problem.breakdown());
   u.frames = frames_of(problem.rollout(), job.time, job.sys->particles());
   for (const auto& [name, value] : job.sys->run_stats()) u.stats[name] = value;
-  u.measures = figure_measures(scene, u.frames);
+  u.measures = measure_keyframes(scene, u.frames);
   return u;
 }
 
@@ -134,14 +135,15 @@ nlohmann::json report_summary(const Scene& scene, bool resuming, const OptimizeR
 
 // Whether the keyframes were reached and, if not, why (opt/diagnosis.h), into job.diagnosis and the report.
 void diagnose_run(const Scene& scene, OptimizeRun& run, const EvaluationLog& elog, const UncontrolledRun& before,
-                  double final_objective, nlohmann::json& report) {
+                  const Trajectory& frames, double final_objective, nlohmann::json& report) {
   StrategyResult& job = run.strategy;
   Problem& problem = *job.problem;
   double effort_end = 0;
   for (const auto& [name, value] : problem.breakdown())
     if (name == "effort") effort_end = value;
   const double final_keyframes = problem.last_diverged() ? final_objective : keyframe_terms(problem.breakdown());
-  const std::vector<KeyframeJudgement> keyframes = judge_keyframes(scene, before.measures, report["measures"]);
+  const std::vector<KeyframeJudgement> keyframes =
+      judge_keyframes(scene, before.measures, measure_keyframes(scene, frames));
   // Under the run's checkpointing and budget: keeping every step of its gradient would hold the whole tape
   // the run itself was checkpointed to avoid, after the run.
   const Sensitivity sensitivity =
@@ -187,7 +189,7 @@ nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, bool re
   nlohmann::json terms = nlohmann::json::object();
   for (const auto& [name, value] : problem.breakdown()) terms[name] = value;
   report["final_terms"] = terms;
-  diagnose_run(scene, run, elog, uncontrolled, final_objective, report);
+  diagnose_run(scene, run, elog, uncontrolled, frames, final_objective, report);
   report["stage_results"] = nlohmann::json::array();
   for (const auto& st : job.stages) report["stage_results"].push_back(stage_json(st));
   if (!job.weight_scales.empty()) report["keyframe_weight_scales"] = job.weight_scales;
@@ -208,11 +210,7 @@ bool keyframes_met(const Scene& scene, Problem& problem) {
 }
 
 std::vector<bool> keyframes_unmet(const Scene& scene, Problem& problem) {
-  const nlohmann::json m =
-      figure_measures(scene, frames_of(problem.rollout(), problem.time(), problem.system().particles()));
-  std::vector<bool> unmet;
-  for (const KeyframeJudgement& k : judge_keyframes(scene, m, m)) unmet.push_back(!k.met());
-  return unmet;
+  return keyframes_unmet(scene, frames_of(problem.rollout(), problem.time(), problem.system().particles()));
 }
 
 }  // namespace kf

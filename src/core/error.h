@@ -14,6 +14,7 @@ enum ExitCode : int {
   kExitOutput = 4,       // an output could not be written
   kExitNotReady = 5,     // a subcommand that is not available yet
   kExitInterrupted = 6,  // stopped by SIGINT, SIGTERM, SIGHUP or SIGQUIT after saving what it had
+  kExitNotReached = 7,   // optimize, run: the keyframes were not reached (run directory written, report.json says why)
   kExitInternal = 10,    // a bug: an unexpected exception
 };
 

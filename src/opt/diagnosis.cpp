@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/overloaded.h"
+#include "core/check.h"
 #include "opt/gradcheck.h"
 #include "opt/problem.h"
 #include "sim/make_system.h"
@@ -21,78 +21,6 @@ std::string format(const char* fmt, double a, double b = 0) {
   std::snprintf(buf, sizeof buf, fmt, a, b);
   return buf;
 }
-
-std::string centimetres(double metres) { return format("%.2f cm", 100 * metres); }
-
-double number(const nlohmann::json& m, const char* key, double fallback = 0) {
-  return m.contains(key) && m.at(key).is_number() ? m.at(key).get<double>() : fallback;
-}
-
-// Fills miss, error text and tolerance text of one judgement from one measure; `after` selects which side.
-struct Judge {
-  const Scene& scene;
-  const ObjectiveSpec& o;
-  KeyframeJudgement& k;
-
-  void distance(const nlohmann::json& mb, const nlohmann::json& ma, const char* key, double tol) {
-    k.judged = true;
-    k.miss_before = number(mb, key) / tol;
-    k.miss_after = number(ma, key) / tol;
-    k.error_before = centimetres(number(mb, key));
-    k.error_after = centimetres(number(ma, key));
-    k.tolerance = centimetres(tol);
-  }
-
-  void operator()(const nlohmann::json& mb, const nlohmann::json& ma) {
-    const double sheet = scene.cloth ? std::max(scene.cloth->width, scene.cloth->height) : 0.0;
-    const double cloth_tol = std::max(0.01, 0.01 * sheet);
-    std::visit(Overloaded{
-                   [&](const PositionKeyframe&) {
-                     if (scene.cloth) return distance(mb, ma, "rms_error", cloth_tol);
-                     if (ma.contains("racer_rank")) {  // a race: the agent first along the heading
-                       k.judged = true;
-                       k.miss_before = number(mb, "racer_rank");
-                       k.miss_after = number(ma, "racer_rank");
-                       k.error_before = format("rank %.0f", k.miss_before);
-                       k.error_after = format("rank %.0f", k.miss_after);
-                       k.tolerance = "rank 1";
-                       return;
-                     }
-                     distance(mb, ma, "rms_error", 0.1);
-                   },
-                   [&](const VelocityKeyframe&) {
-                     k.error_before = format("%.3g m/s", number(mb, "rms_error"));
-                     k.error_after = format("%.3g m/s", number(ma, "rms_error"));
-                   },
-                   [&](const CenterOfMassKeyframe&) {
-                     if (scene.cloth) return distance(mb, ma, "error", cloth_tol);
-                     distance(mb, ma, "error", std::max(0.01, 0.02 * number(ma, "path_length")));
-                   },
-                   [&](const ShapeKeyframe& s) {
-                     const bool coverage = s.coverage_weight > 0;
-                     auto miss = [&](const nlohmann::json& m) {
-                       const double in = (1 - number(m, "inside_fraction")) / (1 - 0.95);
-                       return coverage ? std::max(in, (1 - number(m, "coverage_fraction")) / (1 - 0.9)) : in;
-                     };
-                     auto text = [&](const nlohmann::json& m) {
-                       return coverage ? format("inside %.3f coverage %.3f", number(m, "inside_fraction"),
-                                                number(m, "coverage_fraction"))
-                                       : format("inside %.3f", number(m, "inside_fraction"));
-                     };
-                     k.judged = true;
-                     k.miss_before = miss(mb);
-                     k.miss_after = miss(ma);
-                     k.error_before = text(mb);
-                     k.error_after = text(ma);
-                     k.tolerance = coverage ? "inside >= 0.95 and coverage >= 0.9" : "inside >= 0.95";
-                   },
-                   [&](const ArchKeyframe&) {
-                     distance(mb, ma, "rms_distance", 0.01 * std::max(number(ma, "width"), 1e-9));
-                   },
-               },
-               o.kind);
-  }
-};
 
 }  // namespace
 
@@ -111,18 +39,34 @@ nlohmann::json KeyframeJudgement::to_json() const {
   return j;
 }
 
-std::vector<KeyframeJudgement> judge_keyframes(const Scene& scene, const nlohmann::json& before,
-                                               const nlohmann::json& after) {
+std::vector<KeyframeJudgement> judge_keyframes(const Scene& scene, const std::vector<KeyframeMeasure>& before,
+                                               const std::vector<KeyframeMeasure>& after) {
+  CHECK_EQ(before.size(), scene.objectives.size());
+  CHECK_EQ(after.size(), scene.objectives.size());
   std::vector<KeyframeJudgement> out;
   for (size_t i = 0; i < scene.objectives.size(); ++i) {
     const ObjectiveSpec& o = scene.objectives[i];
     KeyframeJudgement k;
     k.name = std::string(type_name(o)) + "@" + std::to_string(o.frame);
     k.frame = o.frame;
-    Judge{scene, o, k}(before.at(i), after.at(i));
+    k.judged = after[i].judged;
+    k.miss_before = before[i].miss;
+    k.miss_after = after[i].miss;
+    k.error_before = before[i].error;
+    k.error_after = after[i].error;
+    k.tolerance = after[i].tolerance;
+    k.error_phrase = after[i].error_phrase;
+    k.from_target = after[i].from_target;
     out.push_back(std::move(k));
   }
   return out;
+}
+
+std::vector<bool> keyframes_unmet(const Scene& scene, const Trajectory& frames) {
+  const std::vector<KeyframeMeasure> m = measure_keyframes(scene, frames);
+  std::vector<bool> unmet;
+  for (const KeyframeJudgement& k : judge_keyframes(scene, m, m)) unmet.push_back(!k.met());
+  return unmet;
 }
 
 nlohmann::json Sensitivity::to_json() const {
@@ -213,7 +157,7 @@ const KeyframeJudgement* worst_keyframe(const std::vector<KeyframeJudgement>& ke
 
 // Where the worst keyframe ended against its target.
 std::string miss_text(const KeyframeJudgement& worst) {
-  if (worst.tolerance.find("inside") != std::string::npos)
+  if (!worst.from_target)
     return worst.name + " ends at " + worst.error_after + " (needs " + worst.tolerance + "; " + worst.error_before +
            " uncontrolled)";
   return worst.name + " is " + worst.error_after + " from its target (tolerance " + worst.tolerance + "; " +

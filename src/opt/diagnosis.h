@@ -1,7 +1,7 @@
 #pragma once
 // Whether an optimisation reached its keyframes and, when it did not, why and what to change.
 //
-// Each keyframe is judged by its figure measure against a tolerance (keyframe_tolerance below); its miss is
+// Each keyframe is judged by its measure against its kind's tolerance (opt/keyframes/); its miss is
 // the error over the tolerance, so a miss of at most 1 is met. The run fails (keyframe optimize exits with
 // kExitNotReached) when some keyframe is not met; the outcome tells a near miss (progress, every keyframe
 // within kFarMiss tolerances) from a far one and from no meaningful progress (the keyframe terms of φ fell
@@ -15,6 +15,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/trajectory.h"
+#include "opt/keyframes/keyframe_kind.h"
 #include "scene/scene.h"
 
 namespace kf {
@@ -32,17 +34,20 @@ struct KeyframeJudgement {
   double miss_after = 0;
   std::string error_before, error_after;  // the error in the measure's unit ("12.30 cm", "inside 0.620")
   std::string tolerance;                  // "1.20 cm", "inside >= 0.95 and coverage >= 0.9"
+  const char* error_phrase = "";          // how the error reads after it in a line (" from its target")
+  bool from_target = true;                // the error is how far from a target; false: a state ("inside 0.620")
   bool met() const { return !judged || miss_after <= 1.0; }
   nlohmann::json to_json() const;
 };
 
-// Judges scene.objectives[i] by measures[i] (figure_measures of the uncontrolled run and of the result).
-// Cloth position and centre-of-mass keyframes: RMS error within max(1 cm, 1 % of the sheet's longer side);
-// flock shapes: inside_fraction >= 0.95 and, when coverage is asked, coverage_fraction >= 0.9; flock
-// centre-of-mass keyframes: within 2 % of the centre of mass's path; a racer (one agent's position): first
-// along the heading; other flock positions within 0.1 m; arches: RMS distance within 1 % of the width.
-std::vector<KeyframeJudgement> judge_keyframes(const Scene& scene, const nlohmann::json& measures_before,
-                                               const nlohmann::json& measures_after);
+// Judges scene.objectives[i] by its measures in the uncontrolled run (before[i]) and in the result
+// (after[i]), each from measure_keyframes (opt/keyframes/keyframe_kind.h): each kind's file states its
+// tolerance.
+std::vector<KeyframeJudgement> judge_keyframes(const Scene& scene, const std::vector<KeyframeMeasure>& before,
+                                               const std::vector<KeyframeMeasure>& after);
+
+// Whether each keyframe of the scene is unmet in a run's frames (the stop rule's judgement).
+std::vector<bool> keyframes_unmet(const Scene& scene, const Trajectory& frames);
 
 // How the uncontrolled motion propagates perturbations to the keyframes, measured at the start.
 struct Sensitivity {

@@ -6,7 +6,6 @@
 #include <string>
 #include <vector>
 
-#include "core/ground_region.h"  // the shape keyframe's geometry, shared with the figures' measures
 #include "core/types.h"
 #include "scene/objective_spec.h"
 
@@ -21,8 +20,8 @@ class ObjectiveTerm {
   virtual double eval(const VecX& x, const VecX& v, VecX& gx, VecX& gv) const = 0;
 };
 
-// Builds the term a scene's objective entry names, for a system of `particles` particles.
+// Builds the term a scene's objective entry names, for a system of `particles` particles (each kind's term
+// is in its own file, opt/keyframes/<kind>_keyframe.cpp).
 std::unique_ptr<ObjectiveTerm> make_objective_term(const ObjectiveSpec& spec, int particles);
-
 
 }  // namespace kf

@@ -7,7 +7,7 @@
 #include <map>
 #include <variant>
 
-#include "core/overloaded.h"
+#include "opt/keyframes/keyframe_kind.h"
 #include "opt/problem.h"
 
 namespace kf {
@@ -68,28 +68,32 @@ std::map<int, Pose> keyframe_poses(const Scene& scene, const VecX& x0, const Rol
       for (int i : ids) c += at(o.frame, i, target);
       return Vec3(c / double(std::max<size_t>(1, ids.size())));
     };
-    std::visit(Overloaded{[&](const PositionKeyframe& k) {
-                            if (k.targets.size() != ids.size()) {
-                              if (k.targets.size() == 1) poses[o.frame].centre = centre_of(k.targets[0]) + offset;
-                              return;
-                            }
-                            std::vector<Vec3> a, b;
-                            Vec3 cb = Vec3::Zero();
-                            for (size_t j = 0; j < ids.size(); ++j) {
-                              a.push_back(x0.segment<3>(3 * ids[j]));
-                              b.push_back(at(o.frame, ids[j], k.targets[j]));
-                              cb += b.back();
-                            }
-                            cb /= double(b.size());
-                            Pose& pose = poses[o.frame];
-                            pose.turn = best_rotation(a, b);
-                            pose.centre = cb + (pose.turn ? *pose.turn : Mat3::Identity()) * offset;
-                          },
-                          [&](const CenterOfMassKeyframe& k) {
-                            if (!poses.count(o.frame)) poses[o.frame].centre = centre_of(k.target) + offset;
-                          },
-                          [](const auto&) {}},
-               o.kind);
+    const KeyframePlacement place = keyframe_placement(o);
+    switch (place.kind) {
+      case KeyframePlacement::Kind::kNone:
+        break;
+      case KeyframePlacement::Kind::kParticles: {
+        if (place.targets.size() != ids.size()) {
+          if (place.targets.size() == 1) poses[o.frame].centre = centre_of(place.targets[0]) + offset;
+          break;
+        }
+        std::vector<Vec3> a, b;
+        Vec3 cb = Vec3::Zero();
+        for (size_t j = 0; j < ids.size(); ++j) {
+          a.push_back(x0.segment<3>(3 * ids[j]));
+          b.push_back(at(o.frame, ids[j], place.targets[j]));
+          cb += b.back();
+        }
+        cb /= double(b.size());
+        Pose& pose = poses[o.frame];
+        pose.turn = best_rotation(a, b);
+        pose.centre = cb + (pose.turn ? *pose.turn : Mat3::Identity()) * offset;
+        break;
+      }
+      case KeyframePlacement::Kind::kCentroid:
+        if (!poses.count(o.frame)) poses[o.frame].centre = centre_of(place.targets[0]) + offset;
+        break;
+    }
   }
   return poses;
 }

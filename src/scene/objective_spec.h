@@ -51,7 +51,14 @@ struct ArchKeyframe {
   double radius = 1.0;             // cylinder radius, metres
 };
 
-using ObjectiveKind = std::variant<PositionKeyframe, VelocityKeyframe, CenterOfMassKeyframe, ShapeKeyframe, ArchKeyframe>;
+// Cloth: ½w (ȳ − h)², ȳ the mean height (y) of the listed particles: lifted or laid down, anywhere.
+struct HeightKeyframe {
+  static constexpr const char* kName = "height";
+  double height = 0;  // metres
+};
+
+using ObjectiveKind =
+    std::variant<PositionKeyframe, VelocityKeyframe, CenterOfMassKeyframe, ShapeKeyframe, ArchKeyframe, HeightKeyframe>;
 
 // Where an objective came from: the scene's "objectives" array, or a block that adds its own (the
 // character's "end_target" appends a position and a velocity keyframe at the last frame).

@@ -203,6 +203,11 @@ ObjectiveKind parse_arch(Block& b, const ObjectiveSpec&, const Scene& s) {
   return k;
 }
 
+ObjectiveKind parse_height(Block& b, const ObjectiveSpec&, const Scene& s) {
+  if (s.flock) b.fail("type", "\"height\" keyframes are for cloth");
+  return HeightKeyframe{b.number("height", -1e4, 1e4)};
+}
+
 struct ObjectiveType {
   const char* name;
   ObjectiveKind (*parse)(Block&, const ObjectiveSpec&, const Scene&);
@@ -210,7 +215,7 @@ struct ObjectiveType {
 const ObjectiveType kObjectiveTypes[] = {
     {PositionKeyframe::kName, parse_position},         {VelocityKeyframe::kName, parse_velocity},
     {CenterOfMassKeyframe::kName, parse_center_of_mass}, {ShapeKeyframe::kName, parse_shape},
-    {ArchKeyframe::kName, parse_arch},
+    {ArchKeyframe::kName, parse_arch},         {HeightKeyframe::kName, parse_height},
 };
 
 ObjectiveSpec parse_objective(Block b, const Scene& s) {

@@ -10,6 +10,7 @@
 #include "adjoint/rollout.h"
 #include "app/optimize_job.h"
 #include "core/trajectory.h"
+#include "report/cape_end_state.h"
 #include "report/figure_measures.h"
 #include "opt/optimizer.h"
 #include "opt/problem.h"

@@ -17,6 +17,7 @@
 
 #include "app/optimize_job.h"
 #include "opt/gradcheck.h"
+#include "report/collider_measures.h"
 #include "report/figure_measures.h"
 #include "opt/optimizer.h"
 #include "opt/problem.h"

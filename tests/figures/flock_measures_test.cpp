@@ -6,6 +6,7 @@
 #include <limits>
 #include <random>
 
+#include "opt/keyframes/ground_spacing.h"
 #include "report/figure_measures.h"
 #include "scene/scene.h"
 #include "../sim/random_flock.h"

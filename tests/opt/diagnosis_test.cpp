@@ -4,7 +4,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/trajectory.h"
 #include "opt/diagnosis.h"
+#include "opt/keyframes/keyframe_kind.h"
 #include "scene/scene.h"
 
 namespace kf {
@@ -21,18 +23,40 @@ const char* kSheetOnSphere = R"({
                  {"type": "position", "frame": 24, "particles": [0], "targets": [[-0.2, 0.2, -0.3]]}],
   "controls": {"kind": "per_frame"}})";
 
+// A run standing still at state x for `frames` + 1 frames.
+Trajectory standing(const VecX& x, int frames) {
+  Trajectory t;
+  t.particles = int(x.size() / 3);
+  t.x.assign(size_t(frames) + 1, x);
+  t.v.assign(size_t(frames) + 1, VecX::Zero(x.size()));
+  return t;
+}
+
+// The sheet's 144 particles placed so that particle 0 is `pos_error` from its target (along x) and the
+// centre of mass `com_error` from its own.
+VecX sheet_state(double com_error, double pos_error) {
+  const Vec3 q = Vec3(-0.2, 0.2, -0.3) + Vec3(pos_error, 0, 0);
+  const Vec3 p = (144.0 * (Vec3(0.1, 0.5, 0) + Vec3(com_error, 0, 0)) - q) / 143.0;
+  VecX x(3 * 144);
+  for (int i = 0; i < 144; ++i) x.segment<3>(3 * i) = i == 0 ? q : p;
+  return x;
+}
+
 TEST(Diagnosis, ClothKeyframesAreJudgedAgainstOneCentimetreOrOnePercentOfTheSheet) {
   const Scene scene = parse_scene(kSheetOnSphere, "sheet.json");
-  const json before = json::parse(R"([{"error": 0.15}, {"rms_error": 0.30}])");
-  const json after = json::parse(R"([{"error": 0.011}, {"rms_error": 0.013}])");
+  const auto before = measure_keyframes(scene, standing(sheet_state(0.15, 0.30), 24));
+  const auto after = measure_keyframes(scene, standing(sheet_state(0.011, 0.013), 24));
+  EXPECT_NEAR(after[0].report.at("error").get<double>(), 0.011, 1e-12);
+  EXPECT_NEAR(after[1].report.at("rms_error").get<double>(), 0.013, 1e-12);
   const auto k = judge_keyframes(scene, before, after);
   ASSERT_EQ(k.size(), 2u);
   EXPECT_EQ(k[0].name, "center_of_mass@24");
   EXPECT_TRUE(k[0].judged);
-  EXPECT_NEAR(k[0].miss_before, 0.15 / 0.012, 1e-12);  // 1 % of 1.2 m beats 1 cm
+  EXPECT_NEAR(k[0].miss_before, 0.15 / 0.012, 1e-9);  // 1 % of 1.2 m beats 1 cm
   EXPECT_TRUE(k[0].met());
   EXPECT_FALSE(k[1].met());
   EXPECT_EQ(k[1].error_after, "1.30 cm");
+  EXPECT_EQ(k[1].error_before, "30.00 cm");
   EXPECT_EQ(k[1].tolerance, "1.20 cm");
 }
 
@@ -41,13 +65,24 @@ TEST(Diagnosis, FlockShapesNeedInsideAndCoverageOnlyWhereCoverageIsAsked) {
     "objectives": [{"type": "shape", "frame": 10, "polygon": [[0, 0], [5, 0], [5, 5]], "coverage": {"weight": 1}},
                    {"type": "shape", "frame": 10, "polygon": [[0, 0], [5, 0], [5, 5]]}]})",
                                   "flock.json");
-  const json m = json::parse(R"([{"inside_fraction": 0.96, "coverage_fraction": 0.85},
-                                 {"inside_fraction": 0.96, "coverage_fraction": 0.10}])");
+  // Every agent inside, all in one corner: inside, but the region is not filled.
+  VecX x(30);
+  for (int i = 0; i < 10; ++i) x.segment<3>(3 * i) = Vec3(4.5 + 0.01 * i, 0, 0.2);
+  const auto m = measure_keyframes(scene, standing(x, 10));
+  const double coverage = m[0].report.at("coverage_fraction").get<double>();
+  ASSERT_LT(coverage, 0.9);
+  EXPECT_EQ(m[0].report.at("inside_fraction").get<double>(), 1.0);
   const auto k = judge_keyframes(scene, m, m);
-  EXPECT_FALSE(k[0].met());  // coverage 0.85 < 0.9
-  EXPECT_NEAR(k[0].miss_after, 1.5, 1e-12);
-  EXPECT_TRUE(k[1].met());   // no coverage asked
-  EXPECT_EQ(k[1].error_after, "inside 0.960");
+  EXPECT_FALSE(k[0].met());
+  EXPECT_NEAR(k[0].miss_after, (1 - coverage) / 0.1, 1e-12);
+  EXPECT_TRUE(k[1].met());  // no coverage asked
+  EXPECT_EQ(k[1].error_after, "inside 1.000");
+  EXPECT_EQ(k[1].tolerance, "inside >= 0.95");
+  // Three agents outside: 0.7 inside misses by (1 - 0.7) / (1 - 0.95) tolerances.
+  for (int i = 0; i < 3; ++i) x.segment<3>(3 * i) = Vec3(-1, 0, 3);
+  const auto out = judge_keyframes(scene, m, measure_keyframes(scene, standing(x, 10)));
+  EXPECT_NEAR(out[1].miss_after, 0.3 / 0.05, 1e-9);
+  EXPECT_EQ(out[1].error_after, "inside 0.700");
 }
 
 TEST(Diagnosis, SensitivityIsTheSameUnderTheRunsCheckpointingAndBudget) {

@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
+#include "core/ground_region.h"
+
 #include "opt/objective_terms.h"
 
 namespace kf {
@@ -40,8 +44,52 @@ TEST(ObjectiveTerms, GradientsMatchFiniteDifferences) {
   // A region larger than the agents' spread: its coverage term is active at several samples.
   ShapeKeyframe filled{{Vec2(-2.5, -2.5), Vec2(2.5, -2.5), Vec2(2.5, 2.5), Vec2(-2.5, 2.5)}, 0.3, 3.0, 0.7, 0.5};
   ObjectiveSpec coverage{.kind = filled, .frame = 1, .weight = 1.5};
+  ObjectiveSpec height{.kind = HeightKeyframe{0.4}, .frame = 1, .weight = 2.5, .particles = {0, 2, 5}};
   for (unsigned seed : {1u, 2u, 3u})
-    for (const auto& s : {pos, vel, com, shape, arch, coverage}) check_term(s, 6, seed);
+    for (const auto& s : {pos, vel, com, shape, arch, coverage, height}) check_term(s, 6, seed);
+}
+
+// The height term ½w (ȳ − h)² against its definition and central differences at two step sizes, which
+// agree with each other and with the gradient, at states away from the target (a sheet lifted, dropped,
+// and its particles spread).
+TEST(ObjectiveTerms, HeightMatchesItsDefinitionAndCentralDifferencesAtTwoSteps) {
+  const int p = 7;
+  const ObjectiveSpec spec{.kind = HeightKeyframe{0.8}, .frame = 3, .weight = 1.7, .particles = {1, 2, 4, 6}};
+  const auto term = make_objective_term(spec, p);
+  EXPECT_EQ(term->frame(), 3);
+  for (unsigned seed : {4u, 5u, 6u}) {
+    std::srand(seed);
+    VecX x = 3.0 * VecX::Random(3 * p), v = VecX::Random(3 * p);
+    x[3 * 1 + 1] += seed;  // one particle lifted well above the rest
+    double mean = 0;
+    for (int i : spec.particles) mean += x[3 * i + 1] / 4;
+    VecX gx = VecX::Zero(3 * p), gv = VecX::Zero(3 * p);
+    const double phi = term->eval(x, v, gx, gv);
+    EXPECT_NEAR(phi, 0.5 * 1.7 * (mean - 0.8) * (mean - 0.8), 1e-12 * std::max(1.0, phi));
+    EXPECT_EQ(gv.norm(), 0.0);
+    ASSERT_GT(gx.norm(), 1e-3);
+    VecX fd[2] = {VecX::Zero(3 * p), VecX::Zero(3 * p)};
+    const double steps[2] = {1e-4, 1e-6};
+    VecX sx(3 * p), sv(3 * p);
+    for (int s = 0; s < 2; ++s)
+      for (int k = 0; k < 3 * p; ++k) {
+        const double keep = x[k];
+        x[k] = keep + steps[s];
+        const double fp = term->eval(x, v, sx.setZero(), sv.setZero());
+        x[k] = keep - steps[s];
+        const double fm = term->eval(x, v, sx.setZero(), sv.setZero());
+        x[k] = keep;
+        fd[s][k] = (fp - fm) / (2 * steps[s]);
+      }
+    EXPECT_LT((fd[0] - fd[1]).norm(), 1e-6 * gx.norm()) << seed;
+    EXPECT_LT((fd[1] - gx).norm(), 1e-6 * gx.norm()) << seed;
+    for (int i = 0; i < p; ++i) {  // only the listed particles' heights pull
+      const bool listed = std::count(spec.particles.begin(), spec.particles.end(), i) > 0;
+      EXPECT_EQ(gx[3 * i], 0.0);
+      EXPECT_EQ(gx[3 * i + 2], 0.0);
+      if (!listed) EXPECT_EQ(gx[3 * i + 1], 0.0);
+    }
+  }
 }
 
 TEST(ObjectiveTerms, CoverageIsZeroWhenTheRegionIsFilledAndPullsAnAgentIntoAGap) {

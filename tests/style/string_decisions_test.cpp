@@ -1,8 +1,9 @@
 // Decisions outside src/scene/ read types, not text: no file under src/ but the scene layer compares a
-// control kind's name, an optimiser's status text or a strategy's (or split schedule's) name. The names are
-// read once in src/scene/ into enums (ControlKind, StagingStrategy, SplitSchedule) and the optimiser gives a
-// StopReason beside its status text. A line-based scan: each pattern below is one way such a comparison is
-// written.
+// control kind's name, an optimiser's status text, a strategy's (or split schedule's) name or a keyframe
+// judgement's text. The names are read once in src/scene/ into enums (ControlKind, StagingStrategy,
+// SplitSchedule), the optimiser gives a StopReason beside its status text, and a keyframe's judgement says
+// what its error is (KeyframeJudgement::from_target). A line-based scan: each pattern below is one way such a
+// comparison is written.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -37,6 +38,8 @@ const std::vector<std::regex>& patterns() {
         std::regex("\\b(status|strategy|split_schedule)\\w*(\\(\\))?\\s*(==|!=)\\s*(\"|std::string|k[A-Z])"),
         std::regex("\"(" + statuses + ")[^\"]*\"\\s*(==|!=)"),
         std::regex("(==|!=)\\s*kKeyframesReached"),
+        // a keyframe judged by its text: worst.tolerance.find("inside"), k.error_after.rfind("rank", 0)
+        std::regex("\\b(tolerance|error_before|error_after)\\.(r?find|compare|starts_with|ends_with)\\("),
     };
   }();
   return p;
@@ -78,6 +81,7 @@ TEST(StringDecisions, ScanFindsEachWayOfComparingByName) {
       R"(if (problem.last_diverged() || (kind != "per_step" && kind != "per_frame")) return 0;)",
       R"(if (o.strategy == "single" || !scene.cloth) return plan;)",
       R"(job.hold_splits = scene.cloth && scene.optimizer.split_schedule == "held";)",
+      R"(if (worst.tolerance.find("inside") != std::string::npos))",
   };
   for (const std::string& line : bad) EXPECT_EQ(string_decisions(line).size(), 1u) << line;
   const std::vector<std::string> good = {
@@ -85,6 +89,7 @@ TEST(StringDecisions, ScanFindsEachWayOfComparingByName) {
       R"(if (o.strategy == StagingStrategy::kSingle) return plan;)",
       R"(os << "status " << r.status;  // "converged" == "converged")",
       R"(if (name == "effort") effort_end = value;)",
+      R"(if (!worst.from_target))",
   };
   for (const std::string& line : good) EXPECT_TRUE(string_decisions(line).empty()) << line;
 }

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "scene/reach_check.h"
+#include "opt/keyframes/keyframe_reach.h"
 #include "scene/scene.h"
 
 namespace kf {

@@ -1,75 +1,20 @@
-#include "opt/objective_terms.h"
-
+// shape (flocks): agents into a polygon on the ground and, with coverage, filling it. Measured by
+// inside_fraction, coverage_fraction (of the region's sample points with an agent within coverage_radius),
+// coverage_radius, coverage_spacing, min_spacing and median_spacing (nearest-neighbour distances, metres).
+// Tolerance: inside_fraction >= 0.95 and, when coverage is asked, coverage_fraction >= 0.9.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "core/error.h"
 #include "core/ground_point_tree.h"
-#include "core/overloaded.h"
+#include "core/ground_region.h"
+#include "opt/keyframes/ground_spacing.h"
+#include "opt/keyframes/keyframe_common.h"
+#include "opt/keyframes/keyframe_rules.h"
 
 namespace kf {
 
 namespace {
-
-// Particle indices a term applies to: the listed ones, or all.
-std::vector<int> members(const ObjectiveSpec& s, int particles) {
-  if (!s.particles.empty()) return s.particles;
-  std::vector<int> all(particles);
-  for (int i = 0; i < particles; ++i) all[i] = i;
-  return all;
-}
-
-// ½w Σ‖x_i − t_i‖² (position) or ½w Σ‖v_i − t_i‖² (velocity).
-class KeyframeTerm : public ObjectiveTerm {
- public:
-  KeyframeTerm(const ObjectiveSpec& s, const std::vector<Vec3>& targets, int p, bool on_velocity)
-      : frame_(s.frame), w_(s.weight), ids_(members(s, p)), targets_(targets), on_velocity_(on_velocity) {}
-  std::string name() const override { return on_velocity_ ? "velocity" : "position"; }
-  int frame() const override { return frame_; }
-  double eval(const VecX& x, const VecX& v, VecX& gx, VecX& gv) const override {
-    const VecX& q = on_velocity_ ? v : x;
-    VecX& g = on_velocity_ ? gv : gx;
-    long double val = 0;  // extended: round-off in φ sets the floor of a finite-difference check
-    for (size_t k = 0; k < ids_.size(); ++k) {
-      const Vec3 d = seg(q, ids_[k]) - targets_[targets_.size() == 1 ? 0 : k];
-      val += 0.5 * w_ * d.squaredNorm();
-      seg(g, ids_[k]) += w_ * d;
-    }
-    return double(val);
-  }
-
- private:
-  int frame_;
-  double w_;
-  std::vector<int> ids_;
-  std::vector<Vec3> targets_;
-  bool on_velocity_;
-};
-
-// ½w‖x̄ − c‖² with x̄ the mean position of the members.
-class CenterOfMassTerm : public ObjectiveTerm {
- public:
-  CenterOfMassTerm(const ObjectiveSpec& s, const CenterOfMassKeyframe& k, int p)
-      : frame_(s.frame), w_(s.weight), ids_(members(s, p)), target_(k.target) {}
-  std::string name() const override { return "center_of_mass"; }
-  int frame() const override { return frame_; }
-  double eval(const VecX& x, const VecX&, VecX& gx, VecX&) const override {
-    Vec3 mean = Vec3::Zero();
-    for (int i : ids_) mean += seg(x, i);
-    mean /= double(ids_.size());
-    const Vec3 d = mean - target_;
-    const Vec3 g = w_ * d / double(ids_.size());
-    for (int i : ids_) seg(gx, i) += g;
-    return 0.5 * w_ * d.squaredNorm();
-  }
-
- private:
-  int frame_;
-  double w_;
-  std::vector<int> ids_;
-  Vec3 target_;
-};
 
 // ½w Σ max(0, s(x_i) + m)² over agents, s the signed distance to the boundary of a ground region S given
 // as a polygon in (x, z), holes left out (negative inside), m the margin: agents are pulled to at least m inside. With
@@ -85,7 +30,7 @@ class CenterOfMassTerm : public ObjectiveTerm {
 class ShapeTerm : public ObjectiveTerm {
  public:
   ShapeTerm(const ObjectiveSpec& s, const ShapeKeyframe& k, int p)
-      : frame_(s.frame), w_(s.weight), margin_(k.margin), ids_(members(s, p)), region_(k.polygon, k.holes),
+      : frame_(s.frame), w_(s.weight), margin_(k.margin), ids_(keyframe_members(s, p)), region_(k.polygon, k.holes),
         wc_(k.coverage_weight), r_(k.coverage_radius), r2_(r_ * r_), tau_(r2_ / 16),
         samples_(k.coverage_weight > 0 ? region_samples(region_, k.coverage_spacing) : std::vector<Vec2>{}) {}
   std::string name() const override { return "shape"; }
@@ -162,48 +107,56 @@ class ShapeTerm : public ObjectiveTerm {
   mutable std::vector<GroundPointTree::Found> near_;
 };
 
-// ½w Σ (‖r⊥_i‖ − R)², r⊥ the offset of x_i from the cylinder axis: cloth onto an arch.
-class ArchTerm : public ObjectiveTerm {
- public:
-  ArchTerm(const ObjectiveSpec& s, const ArchKeyframe& k, int p)
-      : frame_(s.frame), w_(s.weight), ids_(members(s, p)), a_(k.axis_point), e_(k.axis), r_(k.radius) {}
-  std::string name() const override { return "arch"; }
-  int frame() const override { return frame_; }
-  double eval(const VecX& x, const VecX&, VecX& gx, VecX&) const override {
-    long double val = 0;  // extended: round-off in φ sets the floor of a finite-difference check
-    for (int i : ids_) {
-      const Vec3 d = seg(x, i) - a_;
-      const Vec3 perp = d - d.dot(e_) * e_;
-      const double len = perp.norm();
-      if (len < 1e-12) continue;  // on the axis the distance is not differentiable; no pull
-      const double err = len - r_;
-      val += 0.5 * w_ * err * err;
-      seg(gx, i) += w_ * err * perp / len;
-    }
-    return double(val);
-  }
-
- private:
-  int frame_;
-  double w_;
-  std::vector<int> ids_;
-  Vec3 a_, e_;
-  double r_;
-};
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
 
 }  // namespace
 
-std::unique_ptr<ObjectiveTerm> make_objective_term(const ObjectiveSpec& s, int particles) {
-  using Term = std::unique_ptr<ObjectiveTerm>;
-  return std::visit(
-      Overloaded{
-          [&](const PositionKeyframe& k) -> Term { return std::make_unique<KeyframeTerm>(s, k.targets, particles, false); },
-          [&](const VelocityKeyframe& k) -> Term { return std::make_unique<KeyframeTerm>(s, k.targets, particles, true); },
-          [&](const CenterOfMassKeyframe& k) -> Term { return std::make_unique<CenterOfMassTerm>(s, k, particles); },
-          [&](const ShapeKeyframe& k) -> Term { return std::make_unique<ShapeTerm>(s, k, particles); },
-          [&](const ArchKeyframe& k) -> Term { return std::make_unique<ArchTerm>(s, k, particles); },
-      },
-      s.kind);
-}
+template <>
+struct KeyframeRules<ShapeKeyframe> {
+  static std::unique_ptr<ObjectiveTerm> term(const ObjectiveSpec& s, const ShapeKeyframe& k, int particles) {
+    return std::make_unique<ShapeTerm>(s, k, particles);
+  }
+
+  static KeyframeMeasure measure(const KeyframeRun& run, const ObjectiveSpec&, const ShapeKeyframe& k) {
+    const VecX& x = run.t.x[run.f];
+    const GroundRegion region(k.polygon, k.holes);
+    int inside = 0;
+    const int p = int(x.size() / 3);
+    for (int i = 0; i < p; ++i) inside += polygon_contains(region, Vec2(x[3 * i], x[3 * i + 2]));
+    const auto nn = nearest_neighbour_spacing(x);
+    const double inside_fraction = double(inside) / p;
+    KeyframeMeasure m;
+    m.from_target = false;  // judged by the fractions it reached
+    m.report["inside_fraction"] = inside_fraction;
+    m.report["min_spacing"] = *std::min_element(nn.begin(), nn.end());
+    m.report["median_spacing"] = median(nn);
+    // Filled, not clumped: the fraction of the region's sample points with an agent within the radius.
+    // A crowd's shape may need more samples at its spacing than a region may have: measured more coarsely, so
+    // the report does not fail after the optimisation it reports.
+    const double spacing = sample_spacing_within_limit(region, k.coverage_spacing);
+    const std::vector<Vec2> samples = region_samples(region, spacing);
+    const std::vector<char> near = points_covered(x, samples, k.coverage_radius);
+    const int covered = int(std::count(near.begin(), near.end(), char(1)));
+    const double coverage_fraction = samples.empty() ? 1.0 : double(covered) / double(samples.size());
+    m.report["coverage_fraction"] = coverage_fraction;
+    m.report["coverage_radius"] = k.coverage_radius;
+    m.report["coverage_spacing"] = spacing;
+    const bool coverage = k.coverage_weight > 0;
+    const double in = (1 - inside_fraction) / (1 - 0.95);
+    m.judged = true;
+    m.miss = coverage ? std::max(in, (1 - coverage_fraction) / (1 - 0.9)) : in;
+    m.error = coverage ? format_number("inside %.3f coverage %.3f", inside_fraction, coverage_fraction)
+                       : format_number("inside %.3f", inside_fraction);
+    m.tolerance = coverage ? "inside >= 0.95 and coverage >= 0.9" : "inside >= 0.95";
+    return m;
+  }
+
+  static KeyframePlacement placement(const ObjectiveSpec&, const ShapeKeyframe&) { return {}; }
+};
+
+template struct KeyframeKind<ShapeKeyframe>;
 
 }  // namespace kf

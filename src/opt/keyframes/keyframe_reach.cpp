@@ -1,11 +1,10 @@
-#include "scene/reach_check.h"
+#include "opt/keyframes/keyframe_reach.h"
 
 #include <algorithm>
 #include <cstdio>
 
-#include "core/overloaded.h"
+#include "opt/keyframes/keyframe_kind.h"
 #include "scene/cloth_mesh_spec.h"
-#include "scene/scene.h"
 
 namespace kf {
 namespace {
@@ -46,37 +45,38 @@ std::vector<std::string> unreachable_keyframes(const Scene& scene) {
     if (o.source != ObjectiveSource::kScene) continue;
     auto particle = [&](size_t i) { return o.particles.empty() ? int(i) : o.particles[i]; };
     const size_t n = o.particles.empty() ? size_t(p) : o.particles.size();
+    const KeyframePlacement place = keyframe_placement(o);
     char msg[512] = "";
-    std::visit(Overloaded{
-                   [&](const PositionKeyframe& kf) {
-                     for (size_t i = 0; i < n && !msg[0]; ++i) {
-                       const Vec3& t = kf.targets.size() == 1 ? kf.targets[0] : kf.targets[i];
-                       const Limit w = worst_pin(c, layout_position(c, particle(i)), t);
-                       if (w.ratio > kReachSlack)
-                         std::snprintf(msg, sizeof msg,
-                                       "particle %d's target at frame %d is %.3f m from pin %d, which holds it within "
-                                       "%.3f m (its rest distance): out of reach",
-                                       particle(i), o.frame, w.distance, w.pin, w.reach);
-                     }
-                   },
-                   [&](const CenterOfMassKeyframe& kf) {
-                     for (int pin : c.pins) {
-                       const Vec3 at = layout_position(c, pin);
-                       double reach = 0;
-                       for (size_t i = 0; i < n; ++i) reach = std::max(reach, (layout_position(c, particle(i)) - at).norm());
-                       const double distance = (kf.target - at).norm();
-                       if (distance > kReachSlack * reach) {
-                         std::snprintf(msg, sizeof msg,
-                                       "the centre-of-mass target at frame %d is %.3f m from pin %d, whose particles "
-                                       "here are at most %.3f m from it: out of reach",
-                                       o.frame, distance, pin, reach);
-                         break;
-                       }
-                     }
-                   },
-                   [](const auto&) {},
-               },
-               o.kind);
+    switch (place.kind) {
+      case KeyframePlacement::Kind::kNone:
+        break;
+      case KeyframePlacement::Kind::kParticles:
+        for (size_t i = 0; i < n && !msg[0]; ++i) {
+          const Vec3& t = place.targets.size() == 1 ? place.targets[0] : place.targets[i];
+          const Limit w = worst_pin(c, layout_position(c, particle(i)), t);
+          if (w.ratio > kReachSlack)
+            std::snprintf(msg, sizeof msg,
+                          "particle %d's target at frame %d is %.3f m from pin %d, which holds it within "
+                          "%.3f m (its rest distance): out of reach",
+                          particle(i), o.frame, w.distance, w.pin, w.reach);
+        }
+        break;
+      case KeyframePlacement::Kind::kCentroid:
+        for (int pin : c.pins) {
+          const Vec3 at = layout_position(c, pin);
+          double reach = 0;
+          for (size_t i = 0; i < n; ++i) reach = std::max(reach, (layout_position(c, particle(i)) - at).norm());
+          const double distance = (place.targets[0] - at).norm();
+          if (distance > kReachSlack * reach) {
+            std::snprintf(msg, sizeof msg,
+                          "the centre-of-mass target at frame %d is %.3f m from pin %d, whose particles "
+                          "here are at most %.3f m from it: out of reach",
+                          o.frame, distance, pin, reach);
+            break;
+          }
+        }
+        break;
+    }
     if (msg[0])
       out.push_back(scene.file.string() + ": /objectives/" + std::to_string(k) + ": " + msg +
                     " (the sheet stretches little; move the target or the pins)");

@@ -1,13 +1,15 @@
 #pragma once
 // Keyframes the particles cannot reach. A sheet pinned in place holds each particle within its rest distance
-// from every pin (its springs stretch only a little), so a position target farther than that from a pin is
-// out of reach, and so is a centre-of-mass target farther from a pin than the farthest of its particles can
-// be. Optimising towards such a target ends far from it however long it runs; `keyframe optimize` warns first.
+// from every pin (its springs stretch only a little), so a target for a particle farther than that from a
+// pin is out of reach, and so is a target for the particles' centroid farther from a pin than the farthest
+// of them can be. Optimising towards such a target ends far from it however long it runs; `keyframe
+// optimize` warns first. Each kind says where it places its particles (KeyframePlacement).
 #include <string>
 #include <vector>
 
+#include "scene/scene.h"
+
 namespace kf {
-struct Scene;
 
 // Stretch allowed before a target counts as out of reach (10 % beyond the rest distance).
 constexpr double kReachSlack = 1.1;
