@@ -46,7 +46,8 @@ std::string flock_scene(int frames, int agents) {
 })";
 }
 
-// A cape with every collider shape, an arch keyframe and a schedule whose first stage has its own controls.
+// A cape with every collider shape, arch and height keyframes and a schedule whose first stage has its own
+// controls.
 // `pins` and `anchors` are the alternatives the second cape takes the other way.
 std::string cape_scene(int frames, int n, const std::string& anchors, const std::string& extra) {
   const bool nodes = anchors.find("nodes") != std::string::npos;
@@ -60,6 +61,7 @@ std::string cape_scene(int frames, int n, const std::string& anchors, const std:
   "character": {"file": "character.x", "anchors": )" +
          anchors + extra + R"(},
   "objectives": [{"type": "arch", "frame": 10, "axis_point": [0, 0, 0], "radius": 1},
+                 {"type": "height", "frame": 10, "particles": "bottom_edge", "height": 0.5},
                  {"type": "position", "frame": 5, "particles": {"row": 0, "column": 0, "i": [0, 1], "j": [0, 1],
                   "u": [0, 5], "v": [0, 5]}, "offset": [0, 0.1, 0], "from": "rest"},
                  {"type": "center_of_mass", "frame": 5, "particles": "top_edge", "offset": [0, 0.1, 0]}],

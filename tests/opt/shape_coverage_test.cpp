@@ -8,6 +8,7 @@
 #include <limits>
 #include <random>
 
+#include "core/ground_region.h"
 #include "opt/gradcheck.h"
 #include "opt/objective_terms.h"
 #include "opt/problem.h"

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "core/ground_region.h"
 #include "core/trajectory.h"
 #include "opt/objective_terms.h"
 #include "report/figure_measures.h"

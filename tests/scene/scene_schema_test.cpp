@@ -151,7 +151,7 @@ TEST_F(SceneSchema, KeysCarryTheParsersTypesBoundsAndChoices) {
   const Json& objective = props["objectives"]["items"];
   EXPECT_EQ(objective["required"], Json::parse(R"(["frame", "type"])"));
   EXPECT_EQ(objective["properties"]["type"]["enum"],
-            Json::parse(R"(["position", "velocity", "center_of_mass", "shape", "arch"])"));
+            Json::parse(R"(["position", "velocity", "center_of_mass", "shape", "arch", "height"])"));
   EXPECT_EQ(objective["properties"]["frame"], Json::parse(R"({"type": "integer", "minimum": 0})"));
   // Indices have no upper bound in the schema (it depends on the scene's particle count).
   const Json& particle_forms = objective["properties"]["particles"];
