@@ -138,6 +138,12 @@ void finish_summary(nlohmann::json& summary, int passed, int rows, const std::ve
 nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesystem::path& out) {
   CsvTable t({"scene", "class", "keyframes", "friction", "thrown", "character", "controls", "particles", "keyframe",
               "miss_before", "miss_after", "evaluations", "seconds", "cpu_seconds", "load", "outcome", "pass"});
+  if (!o.plot_classes.empty()) {
+    std::filesystem::path png = o.plot_classes;
+    bar_plot_csv(o.plot_classes, png.replace_extension(".png"), "pass rate by class (1: every scene passed)", {1}, {4},
+                 false);
+    return {{"plot", png.string()}};
+  }
   nlohmann::json summary = {{"seed", o.seed}, {"load_before", load_average()}};
   std::map<std::string, ClassTally> tally;
   ensure_directory(o.scene_dir);

@@ -61,6 +61,9 @@ struct ReachableSweepOptions {
   std::filesystem::path scene_dir = "tests/results/reachable/scenes";  // where the scene files are written
   std::filesystem::path runs_dir = "out/reachable";  // each scene's run directory
   bool generate_only = false;        // write the scene files and stop
+  // A class table (scripts/reachable_classes.py merges the CSVs of a run split over processes): plot its pass
+  // rates as a PNG beside it and stop.
+  std::filesystem::path plot_classes;
   double max_seconds = 0;            // > 0: each scene's optimiser stops after this wall time (per stage)
   // A scene passes only within this many CPU seconds of its whole job (every thread), where it is cut: run
   // the bench with --threads 1 and they are the seconds the job takes on an idle core, whatever the load.

@@ -75,6 +75,7 @@ nlohmann::json bench_robustness(const RobustnessSweepOptions& o, const std::file
       ++rows;
       t.add({name, "", "", "", "", "", "", "", "", "0", fmt(seconds), fmt(cpu_seconds), "cut before its first evaluation",
              "no"});
+      t.write(out / "robustness.csv");
       continue;
     }
     std::ifstream in(outcome.dir / "report.json");
@@ -99,6 +100,7 @@ nlohmann::json bench_robustness(const RobustnessSweepOptions& o, const std::file
            fmt(seconds), fmt(cpu_seconds), cut ? "cut" : report.at("diagnosis").at("outcome").get<std::string>(),
            pass ? "yes" : "no"});
     summary["diagnoses"][name] = outcome.diagnosis;
+    t.write(out / "robustness.csv");  // after every scene: a run stopped early keeps what it measured
   }
   const auto csv = out / "robustness.csv";
   t.write(csv);
