@@ -141,7 +141,12 @@ void add_adjoint_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions
                 "override every scene's evaluation budget (-1: the scene's own)")
       ->capture_default_str()->check(CLI::Range(-1, 1000000));
   r->add_option("--robustness-seconds", o->robustness.max_seconds,
-                "wall-time limit of each scene's optimiser (0: the scene's own); a scene passes only within it")
+                "wall-time limit of each scene's optimiser stages (0: the scene's own)")
+      ->capture_default_str()->check(CLI::Range(0.0, 1e6));
+  r->add_option("--robustness-pass-seconds", o->robustness.pass_seconds,
+                "a scene passes only within this many CPU seconds of its job, where it is cut")
+      ->capture_default_str()->check(CLI::Range(0.0, 1e6));
+  r->add_option("--robustness-wall-seconds", o->robustness.wall_seconds, "a job is cut after this wall time too")
       ->capture_default_str()->check(CLI::Range(0.0, 1e6));
 }
 
@@ -157,12 +162,19 @@ void add_reachable_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o
   r->add_option("--reachable-dir", o->reachable.scene_dir, "where the scene files are written")->capture_default_str();
   r->add_option("--reachable-runs", o->reachable.runs_dir, "where each scene's run directory goes")->capture_default_str();
   r->add_flag("--reachable-generate-only", o->reachable.generate_only, "write the scene files and stop");
+  r->add_option("--reachable-plot", o->reachable.plot_classes,
+                "plot a class table's pass rates (scripts/reachable_classes.py's CSV) as a PNG beside it and stop");
   r->add_flag("--reachable-stop-when-reached", o->reachable.stop_when_reached,
               "every scene with optimizer.stop_when_reached on (measures the stop rule against the default)");
   r->add_option("--reachable-seconds", o->reachable.max_seconds,
-                "wall-time limit of each scene's optimiser stages; a scene passes only within --reachable-pass-seconds")
+                "wall-time limit of each scene's optimiser stages (0: none); a scene passes only within "
+                "--reachable-pass-seconds CPU seconds")
       ->capture_default_str()->check(CLI::Range(0.0, 1e6));
-  r->add_option("--reachable-pass-seconds", o->reachable.pass_seconds, "a scene passes only within this wall time")
+  r->add_option("--reachable-pass-seconds", o->reachable.pass_seconds,
+                "a scene passes only within this many CPU seconds of its job, where it is cut (with --threads 1: "
+                "its seconds on an idle core)")
+      ->capture_default_str()->check(CLI::Range(0.0, 1e6));
+  r->add_option("--reachable-wall-seconds", o->reachable.wall_seconds, "a job is cut after this wall time too")
       ->capture_default_str()->check(CLI::Range(0.0, 1e6));
 }
 

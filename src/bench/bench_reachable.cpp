@@ -2,17 +2,14 @@
 // its default settings and judged by its keyframes (opt/diagnosis.h), a table a scene and one a class.
 #include <algorithm>
 #include <chrono>
-#include <condition_variable>
 #include <csignal>
-#include <sys/resource.h>
-#include <mutex>
-#include <thread>
 #include <fstream>
 #include <iostream>
 #include <map>
 
 #include "bench/bench_point.h"
 #include "bench/bench_reachable.h"
+#include "bench/job_deadline.h"
 #include "app/optimize_job.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -27,14 +24,6 @@ std::string load_average() {
   std::string a, b, c;
   in >> a >> b >> c;
   return a + " " + b + " " + c;
-}
-
-// CPU seconds (user and system, every thread) this process has used: a job's share of the machine, which a
-// loaded machine inflates far less than its wall seconds.
-double process_cpu_seconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 double median(std::vector<double> v) {
@@ -57,45 +46,12 @@ bool wanted(const ReachableSweepOptions& o, const std::string& name) {
 
 extern "C" void ignore_signal(int) {}
 
-// Stops the optimize job running in this process after `seconds` (SIGHUP, which the job answers by saving
-// its best point and writing its run directory), unless it ended first. Between jobs the bench ignores
-// SIGHUP, so a stop that arrives as a job ends does no harm.
-class JobDeadline {
- public:
-  explicit JobDeadline(double seconds)
-      : timer_([this, seconds] {
-          std::unique_lock<std::mutex> lock(m_);
-          if (!cv_.wait_for(lock, std::chrono::duration<double>(seconds), [this] { return done_; })) {
-            fired_ = true;
-            std::raise(SIGHUP);
-          }
-        }) {}
-  ~JobDeadline() {
-    {
-      std::lock_guard<std::mutex> lock(m_);
-      done_ = true;
-    }
-    cv_.notify_all();
-    timer_.join();
-  }
-  bool fired() {
-    std::lock_guard<std::mutex> lock(m_);
-    return fired_;
-  }
-
- private:
-  std::mutex m_;
-  std::condition_variable cv_;
-  bool done_ = false, fired_ = false;
-  std::thread timer_;
-};
-
 struct ClassTally {
   int scenes = 0, passed = 0;
   std::vector<double> evaluations, seconds, cpu_seconds;
 };
 
-// One scene's optimize job, cut at the pass time, and its report (copied to out/reports/).
+// One scene's optimize job, cut at the pass CPU time (or the wall limit), and its report (copied to out/reports/).
 struct SceneRun {
   OptimizeOutcome outcome;
   nlohmann::json report;
@@ -109,7 +65,7 @@ SceneRun run_scene(const ReachableSweepOptions& o, const std::string& name, cons
   OptimizeOptions opt;
   opt.out = (o.runs_dir / name).string();
   opt.quiet = true;
-  opt.max_seconds = o.max_seconds;
+  if (o.max_seconds > 0) opt.max_seconds = o.max_seconds;
   if (o.stop_when_reached) opt.stop_when_reached = 1;
   SceneRun run;
   run.load = load_average();
@@ -118,7 +74,7 @@ SceneRun run_scene(const ReachableSweepOptions& o, const std::string& name, cons
   const double cpu_start = process_cpu_seconds();
   const auto start = std::chrono::steady_clock::now();
   {
-    JobDeadline deadline(o.pass_seconds);
+    JobDeadline deadline(o.pass_seconds, o.wall_seconds);
     run.outcome = optimize_job(file, opt);
     run.cut = deadline.fired();
   }
@@ -182,6 +138,12 @@ void finish_summary(nlohmann::json& summary, int passed, int rows, const std::ve
 nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesystem::path& out) {
   CsvTable t({"scene", "class", "keyframes", "friction", "thrown", "character", "controls", "particles", "keyframe",
               "miss_before", "miss_after", "evaluations", "seconds", "cpu_seconds", "load", "outcome", "pass"});
+  if (!o.plot_classes.empty()) {
+    std::filesystem::path png = o.plot_classes;
+    bar_plot_csv(o.plot_classes, png.replace_extension(".png"), "pass rate by class (1: every scene passed)", {1}, {4},
+                 false);
+    return {{"plot", png.string()}};
+  }
   nlohmann::json summary = {{"seed", o.seed}, {"load_before", load_average()}};
   std::map<std::string, ClassTally> tally;
   ensure_directory(o.scene_dir);
@@ -215,7 +177,7 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
           (!worst || k.at("miss_after").get<double>() > worst->at("miss_after").get<double>()))
         worst = &k;
     if (!worst) continue;
-    const bool pass = !cut && report.at("diagnosis").at("reached").get<bool>() && seconds <= o.pass_seconds;
+    const bool pass = !cut && report.at("diagnosis").at("reached").get<bool>() && run.cpu_seconds <= o.pass_seconds;
     const int evaluations = report.at("evaluations").get<int>();
     passed += pass;
     ++rows;

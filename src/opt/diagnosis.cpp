@@ -268,7 +268,7 @@ std::string untouched_cause(const std::vector<KeyframeJudgement>& keyframes) {
   return "cause: " + untouched->name + " was left at its uncontrolled error (" + untouched->error_after + ", " +
          untouched->error_before + " uncontrolled) while " + met->name + " was met (" + met->error_before + " → " +
          met->error_after + "): the optimiser steered the other keyframe, not this one" +
-         (untouched->frame < met->frame ? " (an earlier keyframe, steered only through the later one's windows)" : "") +
+         (untouched->frame < met->frame ? " (an earlier keyframe)" : "") +
          "; change: raise " + untouched->name + "'s weight, or keyframe it in a scene cut at its frame first";
 }
 

@@ -35,19 +35,33 @@ double Problem::control_scale() const {
   return m.size() ? acceleration * m.mean() : 1.0;
 }
 
+void Problem::hold_forces(std::vector<VecX> forces) {
+  if (forces.size() > size_t(std::max(0, controls_.first_step())))
+    throw std::logic_error("Problem::hold_forces: held forces reach into the controlled steps");
+  for (const VecX& u : forces)
+    if (u.size() != sys_.dof()) throw std::logic_error("Problem::hold_forces: one force per degree of freedom");
+  held_ = std::move(forces);
+}
+
+void Problem::force_at(const VecX& z, int n, VecX& u) const {
+  if (n < controls_.first_step() && size_t(n) < held_.size()) u = held_[size_t(n)];
+  else controls_.force_at(z, n, u);
+}
+
 bool Problem::active(int n) const { return !terms_at_step_[n].empty(); }
 
 void Problem::set_weight_scales(std::vector<double> scales) {
   if (!scales.empty() && scales.size() != terms_.size())
     throw std::logic_error("Problem::set_weight_scales: one scale per keyframe term");
   for (double s : scales)
-    if (!(s > 0) || !std::isfinite(s)) throw std::logic_error("Problem::set_weight_scales: scales must be positive");
+    if (!(s >= 0) || !std::isfinite(s)) throw std::logic_error("Problem::set_weight_scales: scales must not be negative");
   scales_ = std::move(scales);
   if (std::all_of(scales_.begin(), scales_.end(), [](double s) { return s == 1.0; })) scales_.clear();
 }
 
 double Problem::eval_term(int k, const VecX& x, const VecX& v, VecX& gx, VecX& gv) const {
   if (scales_.empty() || scales_[k] == 1.0) return terms_[k]->eval(x, v, gx, gv);
+  if (scales_[k] == 0.0) return 0.0;  // a keyframe this stage is not judged on
   gx_term_.setZero(x.size());  // sized once: the vectors are kept between calls
   gv_term_.setZero(v.size());
   const double g = terms_[k]->eval(x, v, gx_term_, gv_term_);
@@ -66,6 +80,7 @@ double Problem::evaluate(const VecX& z, VecX* grad) {
   controls_.initial_velocity(z, v0_);
   // Forces are made one step at a time, so per-frame controls are never expanded per step.
   const StepControl u_at = [&](int n) -> const VecX& {
+    if (n < controls_.first_step() && size_t(n) < held_.size()) return held_[size_t(n)];
     controls_.force_at(z, n, u_);
     return u_;
   };

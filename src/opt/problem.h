@@ -51,9 +51,18 @@ class Problem : public StateCost {
   std::size_t memory_budget() const { return memory_budget_; }
 
   // Each keyframe term's weight is multiplied by scales[k] (scene.objectives order; empty: all 1), so a
-  // stage may press on keyframes the scene's weights let the effort trade away (opt/keyframe_weights.h).
+  // stage may press on keyframes the scene's weights let the effort trade away (opt/keyframe_weights.h);
+  // a scale of 0 leaves the keyframe out (a stage steering the keyframes before it, opt/windows.h).
   void set_weight_scales(std::vector<double> scales);
   const std::vector<double>& weight_scales() const { return scales_; }
+
+  // Forces of the steps before the controls' first step (forces[n] for step n, 3p each; fewer: no force on
+  // the rest): what earlier stages found there, held while a window later in time is optimised. They are
+  // not variables and their effort is not counted.
+  void hold_forces(std::vector<VecX> forces);
+  const std::vector<VecX>& held_forces() const { return held_; }
+  // The force step n gets under z: a held force before the controls' first step, else the controls'.
+  void force_at(const VecX& z, int n, VecX& u) const;
 
   // Values of each term (keyframe terms by name, then "effort") at the last evaluated point, weighted as φ
   // sums them (with the weight scales).
@@ -81,6 +90,7 @@ class Problem : public StateCost {
   std::vector<std::unique_ptr<ObjectiveTerm>> terms_;
   std::vector<std::vector<int>> terms_at_step_;  // term indices per step
   std::vector<double> scales_;                   // per term; empty: all 1
+  std::vector<VecX> held_;                       // forces of steps before the controls' first (hold_forces)
   mutable VecX gx_term_, gv_term_;               // one scaled term's gradient, before it is added
   VecX v0_;
   VecX u_;  // control force of the step being simulated

@@ -29,26 +29,83 @@ struct Run {
   std::uint64_t all_evaluations = 0;  // recorded on one tape over all stages
   TimeSpec z_time;                    // the time discretisation the controls in r.z were made for
   std::vector<double> weight_scales;  // the keyframe weights' scales every new stage's problem gets
+  std::vector<int> judged_until;      // per stage, the frame its keyframes count up to (opt/windows.h)
   StrategyResult r;
 };
 
+// Forces before `first_step` that `prev` applies under z (its held ones and its controls'): what a window later
+// in time holds (opt/windows.h). Empty when they are all zero.
+std::vector<VecX> forces_before(const Problem& prev, const VecX& z, int first_step) {
+  std::vector<VecX> held(size_t(std::max(0, first_step)));
+  bool any = false;
+  for (size_t n = 0; n < held.size(); ++n) {
+    prev.force_at(z, int(n), held[n]);
+    any = any || held[n].squaredNorm() > 0;
+  }
+  if (!any) held.clear();
+  return held;
+}
+
+// The forces `prev` applies under z from `next`'s first step on, as next's per-particle blocks (a frame's or a
+// step's force): what remap_from takes, with the held forces a window grown back over them takes in.
+VecX forces_as_blocks(const Problem& prev, const VecX& z, const Controls& next) {
+  const int steps = prev.time().steps();
+  const int stride = next.timing() == ControlTiming::kPerFrame ? prev.time().substeps : 1;
+  std::vector<VecX> blocks;
+  VecX u;
+  for (int n = next.first_step(); n < steps; n += stride) {
+    prev.force_at(z, n, u);
+    blocks.push_back(u);
+  }
+  const long size = blocks.empty() ? 0 : long(blocks.size()) * blocks.front().size();
+  VecX out(size);
+  for (size_t b = 0; b < blocks.size(); ++b) out.segment(long(b) * blocks[b].size(), blocks[b].size()) = blocks[b];
+  return out;
+}
+
+// The keyframe weight scales of a stage judged on keyframes up to frame `until` (opt/windows.h): later ones 0.
+std::vector<double> stage_scales(const Scene& scene, const std::vector<double>& scales, int until) {
+  if (until == kAllKeyframes) return scales;
+  std::vector<double> out(scene.objectives.size(), 1.0);
+  for (size_t k = 0; k < out.size(); ++k) {
+    if (k < scales.size()) out[k] = scales[k];
+    if (scene.objectives[k].frame > until) out[k] = 0.0;
+  }
+  return out;
+}
+
 // The stage's problem (its controls carried over from the previous stage's, or the initial guess) with its
-// checkpointing and memory budget set; gives the memory line to print.
-std::string set_up_stage(Run& run, const StageSpec& stage) {
+// checkpointing and memory budget set; gives the memory line to print. A window later in time than the
+// previous stage's holds the forces before it; one grown back over held forces starts from them.
+std::string set_up_stage(Run& run, const StageSpec& stage, int until) {
   StrategyResult& r = run.r;
   Scene stage_scene = run.scene;  // a stage may optimise a coarser control parameterisation
   if (stage.controls) stage_scene.controls = *stage.controls;
   VecX& z = r.z;
-  // The first frame of the previous stage's forces (a resumed run's controls are the scene's).
-  const int z_from_frame = r.problem ? r.problem->controls().first_frame() : run.scene.controls.from_frame;
-  VecX v0_before;  // the initial velocities the previous stage's kind gave, when the kind changes
-  if (r.problem && r.problem->controls().forces())
-    z = r.problem->controls().per_particle_forces(z);  // what remap_from takes (a lattice spread out)
-  else if (r.problem && r.problem->controls().kind() != stage_scene.controls.kind)
-    r.problem->controls().initial_velocity(z, v0_before);
+  std::unique_ptr<Problem> prev = std::move(r.problem);  // its system may be gone: only its controls are read
   r.problem = std::make_unique<Problem>(stage_scene, r.time, *r.sys);
   Problem& problem = *r.problem;
-  problem.set_weight_scales(run.weight_scales);
+  const bool carry_forces = prev && prev->controls().forces() && problem.controls().forces() &&
+                            prev->time().substeps == r.time.substeps && z.size() == prev->size();
+  bool composed = false;
+  if (carry_forces) {
+    problem.hold_forces(forces_before(*prev, z, problem.controls().first_step()));
+    if (!prev->held_forces().empty() && problem.controls().first_step() < prev->controls().first_step() &&
+        prev->controls().timing() == problem.controls().timing() && !r.sys->planar()) {
+      z = problem.controls().remap_from(forces_as_blocks(*prev, z, problem.controls()), r.time,
+                                        problem.controls().first_frame());
+      composed = true;
+    }
+  }
+  // The first frame of the previous stage's forces (a resumed run's controls are the scene's).
+  const int z_from_frame = prev ? prev->controls().first_frame() : run.scene.controls.from_frame;
+  VecX v0_before;  // the initial velocities the previous stage's kind gave, when the kind changes
+  if (prev && !composed) {
+    if (prev->controls().forces()) z = prev->controls().per_particle_forces(z);  // what remap_from takes
+    else if (prev->controls().kind() != stage_scene.controls.kind) prev->controls().initial_velocity(z, v0_before);
+  }
+  prev.reset();
+  problem.set_weight_scales(stage_scales(run.scene, run.weight_scales, until));
   r.tape.begin_stage({std::uint64_t(problem.size()), problem.controls().kind(), problem.controls().first_frame(),
                       r.time.substeps});
   r.tape.expect(std::uint64_t(problem.size()), run.all_evaluations);
@@ -58,7 +115,7 @@ std::string set_up_stage(Run& run, const StageSpec& stage) {
         problem, *r.sys, std::size_t(r.tape.bytes_for(std::uint64_t(problem.size()), run.all_evaluations)));
   if (z.size() == 0) z = problem.initial_guess();
   else if (v0_before.size()) z = problem.controls().from_initial_velocity(v0_before);
-  else z = problem.controls().remap_from(z, run.z_time, z_from_frame);
+  else if (!composed) z = problem.controls().remap_from(z, run.z_time, z_from_frame);
   if (z.size() != problem.size())
     throw InputError(run.controls_file.string() + ": holds " + std::to_string(z.size()) +
                      " controls, the scene needs " + std::to_string(problem.size()));
@@ -171,16 +228,26 @@ void search_throws_first(Run& run) {
 
 // optimizer.stop_when_reached, asked of the problem's last rollout. A checkpointed rollout keeps too few
 // states to judge: the log says so once, and the run goes on by its other rules.
-std::function<bool()> keyframes_reached(Run& run, Problem& problem) {
+// A stage judged on the keyframes up to frame `until` ends when those are met.
+std::function<bool()> keyframes_reached(Run& run, Problem& problem, int until) {
   if (!run.scene.optimizer.stop_when_reached || !run.hooks.keyframes_met) return {};
-  return [&run, &problem, warned = false]() mutable {
+  if (until != kAllKeyframes && !run.hooks.keyframes_unmet) return {};
+  return [&run, &problem, until, warned = false]() mutable {
     if (problem.rollout().every != 0) {
       if (!warned) run.log.say("stop_when_reached: not judged while the rollout is checkpointed");
       warned = true;
       return false;
     }
-    return run.hooks.keyframes_met(problem);
+    if (until == kAllKeyframes) return run.hooks.keyframes_met(problem);
+    const std::vector<bool> unmet = run.hooks.keyframes_unmet(problem);
+    for (size_t k = 0; k < unmet.size() && k < run.scene.objectives.size(); ++k)
+      if (unmet[k] && run.scene.objectives[k].frame <= until) return false;
+    return true;
   };
+}
+
+int judged_until(const Run& run, size_t s) {
+  return s < run.judged_until.size() ? run.judged_until[s] : kAllKeyframes;
 }
 
 // Stage s of the plan: its system (the first is built already), problem and optimisation.
@@ -189,7 +256,7 @@ void run_stage(Run& run, const std::vector<StageSpec>& stages, size_t s) {
   r.time.substeps = stages[s].substeps;
   if (s > 0) r.sys = run.hooks.make_system(r.time.h());
   const bool from_controls_file = run.resuming && s == 0 && r.z.size() > 0;
-  const std::string memory_line = set_up_stage(run, stages[s]);
+  const std::string memory_line = set_up_stage(run, stages[s], judged_until(run, s));
   // A stage at the last one's steps goes on with its schedule: under another, its best point may lie far off.
   if (r.hold_splits && r.schedule.steps() == r.time.steps()) r.sys->hold_step_schedule(r.schedule);
   else hold_schedule_at(r, r.z);
@@ -214,7 +281,7 @@ void run_stage(Run& run, const std::vector<StageSpec>& stages, size_t s) {
   hooks.on_eval = [&](const EvaluationRecord& e) { run.log.evaluation(stage_id, substeps, seconds_before, e); };
   hooks.say = [&](const std::string& line) { run.log.say(line); };
   if (r.hold_splits) hooks.before_restart = [&](const VecX& z, double& phi) { return rehold_schedule(r, z, phi); };
-  hooks.reached = keyframes_reached(run, problem);
+  hooks.reached = keyframes_reached(run, problem, judged_until(run, s));
   run.log.stage_started(spec.max_evaluations);
   const OptimizeResult res =
       minimize_with_restarts(problem, spec, run.scene.optimizer.restarts, r.z, hooks, run.stop, r.tape);
@@ -223,15 +290,27 @@ void run_stage(Run& run, const std::vector<StageSpec>& stages, size_t s) {
 }
 
 // Runs stages[first], stages[first + 1], ...: a stage that converged or stalled early leaves its unspent
-// evaluations to the next (unless every stage has a fixed budget).
+// evaluations to the next (unless every stage has a fixed budget). A window that met the keyframes it is
+// judged on skips the longer windows of the same keyframes.
 void run_stages(Run& run, std::vector<StageSpec>& stages, size_t first) {
   for (size_t s = first;
        s < stages.size() && !run.r.interrupted && run.r.reason != StopReason::kKeyframesReached; ++s) {
     const size_t recorded = run.r.stages.size();
     run_stage(run, stages, s);
     if (run.r.stages.size() == recorded) break;  // stopped before the stage's first evaluation
-    if (s + 1 < stages.size() && !run.fixed_budgets)
-      stages[s + 1].max_evaluations += std::max(0, stages[s].max_evaluations - run.r.stages.back().evaluations);
+    const int until = judged_until(run, s);
+    size_t next = s + 1;
+    if (until != kAllKeyframes && run.r.reason == StopReason::kKeyframesReached) {
+      while (next + 1 < stages.size() && judged_until(run, next) == until) {
+        if (!run.fixed_budgets) stages[next + 1].max_evaluations += stages[next].max_evaluations;
+        ++next;
+      }
+      run.r.reason = StopReason::kConverged;  // of the run: its later keyframes are still to be met
+      run.log.say("the keyframes up to frame " + std::to_string(until) + " are met: on to the next keyframe");
+    }
+    if (next < stages.size() && !run.fixed_budgets)
+      stages[next].max_evaluations += std::max(0, stages[s].max_evaluations - run.r.stages.back().evaluations);
+    s = next - 1;
   }
 }
 
@@ -250,11 +329,14 @@ void windows_after_early_end(Run& run, std::vector<StageSpec>& stages) {
     return;
   const VecX best = r.z;
   const StepSchedule best_schedule = r.schedule;
-  std::vector<StageSpec> windows = window_stages(run.scene, left);
+  std::vector<int> until;
+  std::vector<StageSpec> windows = window_stages(run.scene, left, &until);
+  run.judged_until.resize(stages.size(), kAllKeyframes);
+  run.judged_until.insert(run.judged_until.end(), until.begin(), until.end());
   std::ostringstream os;
   os << "the one stage ended (" << single.status << ") at objective " << std::scientific << std::setprecision(3)
      << single.objective_end << " with " << left
-     << " evaluations left: windows grown back from the last keyframe, from no force";
+     << " evaluations left: windows from no force";
   run.log.say(os.str());
   run.scaled_first_step = true;
   r.problem.reset();
@@ -275,7 +357,8 @@ double scene_keyframe_terms(const Problem& problem) {
   const auto& scales = problem.weight_scales();
   if (terms.empty() || terms.back().first != "effort") return INFINITY;
   double sum = 0;
-  for (size_t k = 0; k + 1 < terms.size(); ++k) sum += terms[k].second / (scales.empty() ? 1.0 : scales[k]);
+  for (size_t k = 0; k + 1 < terms.size(); ++k)
+    if (scales.empty() || scales[k] > 0) sum += terms[k].second / (scales.empty() ? 1.0 : scales[k]);
   return sum;
 }
 
@@ -298,7 +381,7 @@ void press_missed_keyframes(Run& run, std::vector<StageSpec>& stages) {
     const double before = scene_keyframe_terms(problem);
     std::vector<std::string> names;
     for (const auto& term : problem.breakdown()) names.push_back(term.first);
-    run.weight_scales = raised_weight_scales(problem.weight_scales(), unmet, rule, round + 1);
+    run.weight_scales = raised_weight_scales(run.weight_scales, unmet, rule, round + 1);
     run.log.say(describe_raise(names, run.weight_scales, unmet) + " with " + std::to_string(left) + " evaluations");
     const VecX z_before = r.z;
     const StepSchedule schedule_before = r.schedule;
@@ -320,6 +403,21 @@ void press_missed_keyframes(Run& run, std::vector<StageSpec>& stages) {
   }
 }
 
+// A run that ended in a window with forces held before it (interrupted, or its last stages skipped) gives
+// its result in the scene's own controls, the held forces included: what controls.bin, a resume and the
+// report read.
+void release_held_forces(Run& run) {
+  StrategyResult& r = run.r;
+  if (!r.problem || r.problem->held_forces().empty()) return;
+  auto scene_problem = std::make_unique<Problem>(run.scene, r.time, *r.sys);
+  if (scene_problem->controls().timing() != r.problem->controls().timing()) return;
+  r.z = scene_problem->controls().remap_from(forces_as_blocks(*r.problem, r.z, scene_problem->controls()), r.time,
+                                             scene_problem->controls().first_frame());
+  scene_problem->set_checkpoint_every(r.problem->checkpoint_every());
+  scene_problem->set_memory_budget(r.problem->memory_budget());
+  r.problem = std::move(scene_problem);
+}
+
 }  // namespace
 
 StrategyResult run_strategy(StrategySetup setup, const StrategyHooks& hooks, StrategyLog& log) {
@@ -329,6 +427,7 @@ StrategyResult run_strategy(StrategySetup setup, const StrategyHooks& hooks, Str
           setup.controls_file, setup.stop,        hooks,
           log};
   std::vector<StageSpec> stages = setup.plan.stages;
+  run.judged_until = setup.plan.judged_until;
   for (const auto& st : stages) run.all_evaluations += std::uint64_t(std::max(st.max_evaluations, 1));
   run.z_time = setup.start.size() ? setup.start_time : scene.time;
   StrategyResult& r = run.r;
@@ -341,6 +440,7 @@ StrategyResult run_strategy(StrategySetup setup, const StrategyHooks& hooks, Str
   run_stages(run, stages, 0);
   windows_after_early_end(run, stages);
   press_missed_keyframes(run, stages);
+  release_held_forces(run);
   r.weight_scales = run.weight_scales;
   if (r.problem) r.problem->set_weight_scales({});
   r.planned_stages = int(stages.size());

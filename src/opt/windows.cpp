@@ -21,44 +21,120 @@ int last_keyframe(const Scene& scene) {
 
 }  // namespace
 
-// Windows grown backwards from the last keyframe. The first (shortest) window gets half the budget, the
-// others share the rest equally: its gradient is the only tame one, so it does most of the work and is still
-// descending at an equal share, while longer windows mostly stall within a few evaluations and pass their
-// unspent budget on. Per-frame forces act on the 3 x 3 lattice in every window, then per particle over the
-// last (the whole) window.
-std::vector<StageSpec> window_stages(const Scene& scene, int budget) {
-  const OptimizerSpec& o = scene.optimizer;
+std::vector<int> keyframe_frames(const Scene& scene) {
+  std::vector<int> frames;
+  for (const auto& o : scene.objectives)
+    if (o.frame > scene.controls.from_frame && o.frame <= scene.time.frames) frames.push_back(o.frame);
+  std::sort(frames.begin(), frames.end());
+  frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
+  return frames;
+}
+
+namespace {
+
+// A stage with fewer evaluations than this rarely gets past its line search's first trials.
+constexpr int kMinStageEvaluations = 12;
+
+struct Window {
+  int start;         // its first controlled frame
+  int until;         // the frame its keyframes count up to (kAllKeyframes: all)
+  bool lead;         // the first (shortest) window of its keyframe: the tame gradient, the larger share
+};
+
+// Windows grown backwards from the keyframe at `frame` down to `lower`: frame - w, frame - 2w, ... above
+// lower, then lower.
+void grow_back(std::vector<Window>& out, int frame, int lower, int window_frames, int until) {
+  bool lead = true;
+  for (long w = window_frames; frame - w > lower; w *= 2, lead = false) out.push_back({int(frame - w), until, lead});
+  out.push_back({lower, until, lead});
+}
+
+// The windows in time order: each keyframe's grown back from it, the earliest's to controls.from_frame and
+// each later one's to the keyframe before it, only keyframes up to its own counting (the last: all).
+std::vector<Window> plan_windows(const Scene& scene) {
+  const ControlSpec& c = scene.controls;
+  const std::vector<int> frames = keyframe_frames(scene);
+  std::vector<Window> windows;
+  if (frames.size() < 2) {
+    grow_back(windows, last_keyframe(scene), c.from_frame, scene.optimizer.window_frames, kAllKeyframes);
+    return windows;
+  }
+  int lower = c.from_frame;
+  for (size_t k = 0; k < frames.size(); ++k) {
+    grow_back(windows, frames[k], lower, scene.optimizer.window_frames,
+              k + 1 < frames.size() ? frames[k] : kAllKeyframes);
+    lower = frames[k];
+  }
+  return windows;
+}
+
+}  // namespace
+
+// The first (shortest) window of a keyframe gets the larger share: its gradient is the only tame one, so it
+// does most of the work and is still descending at an equal share, while longer windows mostly stall within
+// a few evaluations and pass their unspent budget on. Per-frame forces act on the 3 x 3 lattice in every
+// window, then per particle over the last (the whole) window; with keyframes at several frames a last stage
+// of the scene's own controls over the whole horizon follows the windows.
+std::vector<StageSpec> window_stages(const Scene& scene, int budget, std::vector<int>* judged_until) {
   const ControlSpec& c = scene.controls;
   const bool lattice = c.kind == ControlKind::kPerFrame;
-  const int last = last_keyframe(scene);
-  std::vector<int> starts;  // latest first: K - w, K - 2w, K - 4w, ... above from_frame, then from_frame
-  for (long w = o.window_frames; last - w > c.from_frame; w *= 2) starts.push_back(int(last - w));
-  starts.push_back(c.from_frame);
-  const int windows = int(starts.size()), n = windows + (lattice ? 1 : 0);
-  const int first = n > 1 ? std::max(1, budget / 2) : budget;
-  const int part = n > 1 ? std::max(1, (budget - first) / (n - 1)) : 0;
+  std::vector<Window> windows = plan_windows(scene);
+  const bool ordered = keyframe_frames(scene).size() > 1;
+  const int extra = lattice || ordered ? 1 : 0;  // the last stage over the whole horizon, when it is not a window
+  // A budget below what every window needs plans fewer windows, rather than each cut short: the middle
+  // windows of each keyframe go first, the longest before the shorter; each keyframe keeps its first
+  // window and the one reaching down to where its windows end.
+  for (size_t k = windows.size(); k-- > 0 && int(windows.size() + extra) * kMinStageEvaluations > budget;) {
+    const bool bottom = k + 1 == windows.size() || windows[k + 1].until != windows[k].until;
+    if (!windows[k].lead && !bottom) windows.erase(windows.begin() + long(k));
+  }
+  // The last window of a single keyframe, when it is not on the lattice, is the scene's own controls.
+  const int n = int(windows.size()) + extra;
+  int leads = 0;
+  for (const Window& w : windows) leads += w.lead;
+  const int lead_share = n > 1 ? std::max(1, budget / 2 / std::max(1, leads)) : budget;
+  const int others = n - leads;
+  const int part = others > 0 ? std::max(1, (budget - lead_share * leads) / others) : 0;
   std::vector<StageSpec> stages;
+  if (judged_until) judged_until->clear();
+  int given = 0;
   for (int k = 0; k < n; ++k) {
-    const int share = k == 0 ? first : k + 1 < n ? part : std::max(1, budget - first - part * (n - 2));
+    const bool lead = k < int(windows.size()) && windows[k].lead;
+    const int share = k + 1 < n ? (lead ? lead_share : part) : std::max(1, budget - given);
+    given += share;
     StageSpec s{scene.time.substeps, share, std::nullopt};
     if (k + 1 < n) {
       ControlSpec window = c;
-      window.from_frame = starts[k];
+      window.from_frame = windows[k].start;
       if (lattice) window.kind = ControlKind::kPerFrameLattice;
       s.controls = window;
     }
     stages.push_back(s);
+    if (judged_until) judged_until->push_back(k < int(windows.size()) ? windows[k].until : kAllKeyframes);
   }
   return stages;
 }
 
 namespace {
 
-std::string describe(const std::vector<StageSpec>& stages, int scene_from) {
+// "windows from frames 23, 18, 8, 0 to frame 28", or in keyframe order "windows to frame 12 from frames 7,
+// 2, 0, then to frame 28 (every keyframe) from frames 23, 18, 12".
+std::string describe(const std::vector<StageSpec>& stages, const std::vector<int>& until, int last, int scene_from) {
   std::ostringstream os;
+  const bool ordered = std::find(until.begin(), until.end(), kAllKeyframes) != until.begin();
   const bool lattice = stages.front().controls && stages.front().controls->kind == ControlKind::kPerFrameLattice;
-  for (size_t k = 0; k + (lattice ? 1 : 0) < stages.size(); ++k)
-    os << (k ? ", " : "") << (stages[k].controls ? stages[k].controls->from_frame : scene_from);
+  const size_t windows = ordered || lattice ? stages.size() - 1 : stages.size();
+  os << "windows";
+  for (size_t k = 0; k < windows; ++k) {
+    const bool group_start = k == 0 || until[k] != until[k - 1];
+    if (ordered && group_start)
+      os << (k ? ", then" : "") << " to frame " << (until[k] == kAllKeyframes ? last : until[k])
+         << (until[k] == kAllKeyframes ? " (every keyframe)" : "") << " from frames ";
+    else if (!ordered && k == 0) os << " from frames ";
+    else os << ", ";
+    os << (stages[k].controls ? stages[k].controls->from_frame : scene_from);
+  }
+  if (!ordered) os << " to frame " << last;
   return os.str();
 }
 
@@ -107,8 +183,11 @@ StagePlan plan_stages(const Scene& scene) {
     plan.stages = {{scene.time.substeps, rigid_budget, rigid}};
     if (lattice_budget > 0) plan.stages.push_back({scene.time.substeps, lattice_budget, lattice});
     plan.stages.push_back({scene.time.substeps, o.max_evaluations - rigid_budget - lattice_budget, std::nullopt});
+    // The automatic search spends at most twice the budget in throws (each a simulation without its adjoint
+    // pass): a budget the user cut cuts the search too.
     plan.throw_search = o.throw_search >= 0 ? o.throw_search
-                                            : automatic_throw_count(scene.cloth->particles(), scene.time.steps());
+                                            : std::min(automatic_throw_count(scene.cloth->particles(), scene.time.steps()),
+                                                       2 * o.max_evaluations);
     plan.why = "stages: a search over " + std::to_string(plan.throw_search) +
                " rigid throws, the best rigid throw (6 variables), a 3 x 3 lattice of initial velocities over the "
                "sheet from it, then one initial velocity per particle";
@@ -129,14 +208,15 @@ StagePlan plan_stages(const Scene& scene) {
   // the contact that makes a per-particle gradient rough may begin only later (a towel sliding off its rail).
   const bool contact = c.kind == ControlKind::kPerFrame && (!scene.cloth->colliders.empty() || scene.character);
   if (plan.growth > o.window_growth || contact) {
-    plan.stages = window_stages(scene, o.max_evaluations);
+    plan.stages = window_stages(scene, o.max_evaluations, &plan.judged_until);
     plan.scaled_first_step = true;
     if (plan.growth > o.window_growth) os << " (above optimizer.window_growth " << o.window_growth << ")";
     else os << " (the sheet meets colliders or a body)";
-    os << ": windows from frames "
-       << describe(plan.stages, c.from_frame) << " to frame " << last;
+    os << ": " << describe(plan.stages, plan.judged_until, last, c.from_frame);
     if (c.kind == ControlKind::kPerFrame)
       os << ", each on a 3 x 3 lattice of forces over the sheet, then one force per particle from frame " << c.from_frame;
+    else if (keyframe_frames(scene).size() > 1)
+      os << ", then the scene's forces from frame " << c.from_frame;
   } else {
     os << " (not above optimizer.window_growth " << o.window_growth
        << "): one stage, then windows from no force if it ends early with evaluations left";

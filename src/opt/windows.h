@@ -10,10 +10,14 @@
 //    twice, four times ... as long, down to controls.from_frame; each stage starts from the forces
 //    the last one found (new frames without force), so a longer window can only improve on it. Below the
 //    threshold, one stage, and the windows if it ends early with evaluations left. Per-frame
-//    forces act on a 3 x 3 lattice over the sheet in every window, then per particle over the whole one:
+//    forces act on a 3 x 3 lattice over the sheet in every window, then per particle over the whole one.
+//    With keyframes at several frames the windows go in time order: those grown back from the earliest
+//    keyframe (later ones left out, so it is met first), then those grown back from the next down to the
+//    keyframe before it (the forces before the window held as found), and so on; the last stage optimises
+//    every keyframe over the whole horizon. Grown back from the last keyframe alone, the windows reach an
+//    early keyframe only when they are long, where their line searches stall and leave it uncontrolled;
 //    in contact a per-particle gradient is ruled by the few particles touching, and its line search stalls
-//    where a force on the sheet as a whole still moves it (a cape on a swinging body: 8.8 cm per particle,
-//    on target on the lattice). A tame gradient (a sheet in free flight) keeps one stage.
+//    where a force on the sheet as a whole still moves it (a cape on a swinging body). A tame gradient (a sheet in free flight) keeps one stage.
 //  - per-particle initial velocities start from the best rigid throw (six numbers; ring-toss.json's stages),
 //    found by a search over throws and then L-BFGS, bent by a 3 x 3 lattice of velocities over the sheet
 //    (27 numbers, smooth over it) before every particle gets its own.
@@ -26,20 +30,22 @@
 
 namespace kf {
 
+// A stage's keyframes: those up to this frame count (later ones are left out), or all.
+constexpr int kAllKeyframes = -1;
+
 struct StagePlan {
   std::vector<StageSpec> stages;  // at least one; the last optimises the scene's own controls
+  std::vector<int> judged_until;  // per stage, the frame its keyframes count up to (missing: kAllKeyframes)
   double growth = 0;              // the force gradient's growth at the start (0: not measured)
   int throw_search = 0;           // rigid throws simulated before the first (rigid) stage (opt/throw_search.h)
   // The strategy staged the run (windows, or a rigid throw first), or the scene is a flock: an automatic
   // optimizer.first_step is then the problem's control_scale(); elsewhere it is off. A flock's whole
-  // gradient grows with its size (10,000 agents: 4.8 N RMS per variable at the start), and a first trial
-  // step that long herds a crowd into a dense band it never leaves.
+  // gradient grows with its size, and a first trial step that long herds a crowd into a dense band it never leaves.
   bool scaled_first_step = false;
   // One stage of forces whose start is tame: when it ends early (its line search stalls, or it converges)
   // with evaluations left, the run optimises again in windows from no force with what is left
   // (window_stages) and keeps the better result. A tame start may roughen later, and one stage over the
-  // whole horizon may settle on forces far costlier than windows find (a flag released in its plane: 5e-2
-  // against 1e-6).
+  // whole horizon may settle on forces far costlier than windows find (a flag released in its plane).
   bool windows_on_early_end = false;
   std::string why;                // one line: the plan and what chose it
 };
@@ -47,9 +53,14 @@ struct StagePlan {
 // The stages of `scene`. Measuring the growth costs one simulation and its adjoint pass.
 StagePlan plan_stages(const Scene& scene);
 
-// The windows grown back from the last keyframe for per-step or per-frame forces, sharing `budget`
-// evaluations (the first window half of them).
-std::vector<StageSpec> window_stages(const Scene& scene, int budget);
+// The windows for per-step or per-frame forces, sharing `budget` evaluations: grown back from the last
+// keyframe (the first window half of them), or, with keyframes at several frames, grown back from each
+// keyframe in time order (the first window of each keyframe sharing half). `judged_until`, when given,
+// gets each stage's keyframe frame (kAllKeyframes: every keyframe counts).
+std::vector<StageSpec> window_stages(const Scene& scene, int budget, std::vector<int>* judged_until = nullptr);
+
+// The distinct frames of the scene's keyframes that forces from controls.from_frame can move, in order.
+std::vector<int> keyframe_frames(const Scene& scene);
 
 // Per-frame force controls' gradient at z: the largest frame's gradient norm over the norm of frame
 // `reference`'s (infinite when that is zero and another is not; 1 when all are zero).

@@ -18,9 +18,12 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// Scene 1 of each class (two keyframes where the class has them); scene 0 (one keyframe) of the drop onto a
-// collider, whose scene 1 leaves its early keyframe behind (DiagnosisTruth.GeneratedDrop...), and of the
-// blanket on Testwuson.X, whose scene 1 ends its budget short of its keyframes (REPORT, known limitations).
+// Scene 1 of each class (two keyframes where the class has them: the cape's early keyframe was left at its
+// uncontrolled error while windows grew back from the last keyframe alone, opt/windows.h); scene 0 (one
+// keyframe) of the drop onto a collider, whose reduced scene 1 misses both keyframes (the sheet meeting its
+// early keyframe then falls onto the collider where the late one cannot be reached from windows after it;
+// REPORT, known limitations), and of the blanket on Testwuson.X, whose scene 1 ends its budget short of its
+// keyframes.
 int scene_index(const std::string& kind) { return kind == "drop-collider" || kind == "cape-wuson" ? 0 : 1; }
 
 void expect_reduced_scene_meets_its_keyframes(const std::string& kind) {
@@ -41,6 +44,30 @@ void expect_reduced_scene_meets_its_keyframes(const std::string& kind) {
     missed_before |= k.at("miss_before").get<double>() > 1.0;
   }
   EXPECT_TRUE(missed_before) << "every keyframe met without optimising";
+}
+
+// The generated cape-1 at its full size (a 10 x 18 cape on BCN_Epileptic.X, keyframes at frames 13 and 30):
+// windows grown back from the last keyframe alone met the late one and left the early centre of mass at its
+// uncontrolled error; windows in keyframe order (opt/windows.h) meet both.
+TEST(ReachableCapeScenes, AnEarlyKeyframeIsMetBeforeTheLastOne) {
+  test::TempDir dir;
+  const ReachableScene r = generate_reachable("cape", 52, 1, false, dir.path());
+  std::ofstream(dir.path() / "scene.json") << r.scene.dump(1);
+  OptimizeOptions opt;
+  opt.quiet = true;
+  opt.out = (dir.path() / "run").string();
+  const OptimizeOutcome outcome = optimize_job(dir.path() / "scene.json", opt);
+  EXPECT_FALSE(outcome.failed) << outcome.diagnosis;
+  std::ifstream in(dir.path() / "run" / "report.json");
+  const json report = json::parse(in);
+  ASSERT_EQ(report.at("keyframe_errors").size(), 2u);
+  const json* early = nullptr;
+  for (const json& k : report.at("keyframe_errors")) {
+    EXPECT_TRUE(k.at("met").get<bool>()) << k.dump();
+    if (!early || k.at("frame").get<int>() < early->at("frame").get<int>()) early = &k;
+  }
+  EXPECT_LT(early->at("frame").get<int>(), 30);
+  EXPECT_GT(early->at("miss_before").get<double>(), 1.0) << "the early keyframe was met uncontrolled";
 }
 
 // The classes without and with a character (Embree's queries run untrapped: tests/test_main.cpp).

@@ -3,6 +3,7 @@
 // search, the stop rule, an interruption, and the windows after a single stage that ended early.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <string>
 #include <vector>
@@ -217,14 +218,80 @@ TEST(StrategyRun, ASingleStageThatEndedEarlyIsFollowedByWindows) {
   EXPECT_EQ(run.log.said("the one stage ended (converged"), 1);
   const std::vector<StageSpec> windows = window_stages(scene, 200 - r.stages[0].evaluations);
   EXPECT_EQ(r.planned_stages, 1 + int(windows.size()));
-  // The windows start from no force over the shortest window, on the lattice.
+  // The windows start from no force over the shortest window before the earlier keyframe (frame 12), on the
+  // lattice.
   EXPECT_EQ(run.log.said("optimising strategy_run stage 2"), 1);
   ASSERT_EQ(run.log.said("optimising strategy_run stage 2: toy chain"), 1);
   for (const auto& line : run.log.lines)
-    if (line.rfind("optimising strategy_run stage 2", 0) == 0) EXPECT_NE(line.find("(per_frame_lattice from frame 23)"), std::string::npos) << line;
+    if (line.rfind("optimising strategy_run stage 2", 0) == 0) EXPECT_NE(line.find("(per_frame_lattice from frame 7)"), std::string::npos) << line;
   // The result is the better of the single stage and the windows.
   const bool windows_kept = r.stages.back().objective_end < r.stages[0].objective_end;
   EXPECT_EQ(run.log.said("the windows ended no lower"), windows_kept ? 0 : 1);
+}
+
+// The toy's centre of mass at `frame` of the problem's last rollout, and its distance to `target`.
+double com_miss(const Problem& p, int frame, const Vec3& target) {
+  const VecX& x = p.rollout().x[size_t(frame * p.time().substeps)];
+  Vec3 c = Vec3::Zero();
+  for (long i = 0; i < x.size() / 3; ++i) c += x.segment<3>(3 * i);
+  return (c / double(x.size() / 3) - target).norm();
+}
+
+TEST(StrategyRun, KeyframesAtSeveralFramesAreSteeredInTimeOrder) {
+  // Keyframes at frames 12 and 28, per-step forces from frame 0, windows of 5 frames: first the windows
+  // grown back from frame 12 (only that keyframe counts), then those grown back from frame 28 down to 12
+  // (both count; the forces before the window held), then the whole horizon.
+  const Scene scene =
+      toy_scene(R"({"split_schedule": "adaptive", "stop_when_reached": true, "window_frames": 5})", R"({"kind": "per_step"})");
+  StagePlan plan;
+  plan.stages = window_stages(scene, 240, &plan.judged_until);
+  std::vector<int> starts;
+  for (const auto& st : plan.stages) starts.push_back(st.controls ? st.controls->from_frame : -1);
+  EXPECT_EQ(starts, (std::vector<int>{7, 2, 0, 23, 18, 12, -1}));
+  EXPECT_EQ(plan.judged_until, (std::vector<int>{12, 12, 12, kAllKeyframes, kAllKeyframes, kAllKeyframes, kAllKeyframes}));
+  // Each keyframe's first window shares half the budget.
+  EXPECT_EQ(plan.stages[0].max_evaluations, 60);
+  EXPECT_EQ(plan.stages[3].max_evaluations, 60);
+  const Vec3 early(0.1, 0.1, 0.1), late(0.3, 0.1, 0.2);
+  constexpr double kTolerance = 0.05;
+  std::vector<double> early_miss_in_late_windows;
+  const auto unmet = [&](Problem& p) {
+    const double e = com_miss(p, 12, early), l = com_miss(p, 28, late);
+    if (p.controls().first_frame() > 12) early_miss_in_late_windows.push_back(e);
+    return std::vector<bool>{l > kTolerance, e > kTolerance};  // scene.objectives order
+  };
+  StrategyHooks hooks;
+  hooks.make_system = [](double h) { return std::make_unique<test::ToySystem>(4, h); };
+  hooks.keyframes_unmet = unmet;
+  hooks.keyframes_met = [&](Problem& p) {
+    const std::vector<bool> u = unmet(p);
+    return !u[0] && !u[1];
+  };
+  StrategySetup setup{scene, plan};
+  setup.system = hooks.make_system(scene.time.h());
+  ToyLog log;
+  StrategyResult r = run_strategy(std::move(setup), hooks, log);
+  // The early keyframe was met in its own windows, and the run went on to the later one.
+  EXPECT_EQ(log.said("the keyframes up to frame 12 are met: on to the next keyframe"), 1);
+  std::vector<int> from;
+  for (const auto& line : log.lines)
+    if (line.rfind("optimising strategy_run stage", 0) == 0) {
+      const size_t at = line.find("from frame ");
+      from.push_back(at == std::string::npos ? 0 : std::stoi(line.substr(at + 11)));
+    }
+  // First windows before frame 12, then the rest of the early keyframe's windows skipped (three planned).
+  const size_t first_late = size_t(std::find_if(from.begin(), from.end(), [](int f) { return f > 12; }) - from.begin());
+  ASSERT_LT(first_late, from.size());
+  EXPECT_GE(first_late, 1u);
+  EXPECT_LT(first_late, 3u);
+  for (size_t k = first_late; k + 1 < from.size(); ++k) EXPECT_GE(from[k], 12) << "stage " << k + 1;
+  // While a window after frame 12 was optimised, the forces before it were held: the early keyframe stayed met.
+  ASSERT_FALSE(early_miss_in_late_windows.empty());
+  for (double e : early_miss_in_late_windows) EXPECT_LE(e, kTolerance);
+  EXPECT_EQ(r.reason, StopReason::kKeyframesReached) << r.status;
+  r.problem->evaluate(r.z, nullptr);
+  EXPECT_LE(com_miss(*r.problem, 28, late), kTolerance);
+  EXPECT_LE(com_miss(*r.problem, 12, early), kTolerance);
 }
 
 }  // namespace

@@ -92,14 +92,16 @@ std::vector<int> window_starts(const std::vector<StageSpec>& stages, int scene_f
   return starts;
 }
 
-TEST(Strategy, ClothForcesGrowWindowsBackwardsFromTheLastKeyframe) {
+TEST(Strategy, ClothForcesGrowWindowsBackwardsFromEachKeyframeInTimeOrder) {
   // A force early in free flight moves the keyframe more than a late one: growth above 1, so a threshold
   // of 1 asks for windows.
   const Scene scene = strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"max_evaluations": 300, "window_growth": 1})");
   const StagePlan plan = plan_stages(scene);
   EXPECT_GT(plan.growth, 1);
-  // Per-frame forces: each window on the lattice, then per particle over the whole horizon.
-  EXPECT_EQ(window_starts(plan.stages, 0), (std::vector<int>{23, 18, 8, 0, 0}));
+  // Keyframes at frames 12 and 28: windows grown back from 12 (only it counts), then from 28 down to 12
+  // (both count), each on the lattice, then per particle over the whole horizon.
+  EXPECT_EQ(window_starts(plan.stages, 0), (std::vector<int>{7, 2, 0, 23, 18, 12, 0}));
+  EXPECT_EQ(plan.judged_until, (std::vector<int>{12, 12, 12, kAllKeyframes, kAllKeyframes, kAllKeyframes, kAllKeyframes}));
   for (size_t k = 0; k + 1 < plan.stages.size(); ++k)
     EXPECT_EQ(plan.stages[k].controls->kind, ControlKind::kPerFrameLattice) << "stage " << k;
   int budget = 0;
@@ -108,18 +110,25 @@ TEST(Strategy, ClothForcesGrowWindowsBackwardsFromTheLastKeyframe) {
     EXPECT_EQ(s.substeps, 2);
   }
   EXPECT_EQ(budget, 300);
-  EXPECT_EQ(plan.stages.front().max_evaluations, 150);  // the shortest window's gradient is the tame one
-  EXPECT_EQ(plan.stages[1].max_evaluations, 37);
+  // Each keyframe's shortest window (the tame gradient) shares half the budget.
+  EXPECT_EQ(plan.stages[0].max_evaluations, 75);
+  EXPECT_EQ(plan.stages[3].max_evaluations, 75);
+  EXPECT_EQ(plan.stages[1].max_evaluations, 30);
   EXPECT_FALSE(plan.stages.back().controls);  // the last stage optimises the scene's own controls
   EXPECT_TRUE(plan.scaled_first_step);
-  EXPECT_NE(plan.why.find("windows from frames 23, 18, 8, 0 to frame 28, each on a 3 x 3 lattice"), std::string::npos)
+  EXPECT_NE(plan.why.find("windows to frame 12 from frames 7, 2, 0, then to frame 28 (every keyframe) from frames 23, "
+                          "18, 12, each on a 3 x 3 lattice"),
+            std::string::npos)
       << plan.why;
-  // Per-step forces have no lattice: their windows are per particle.
+  // Per-step forces have no lattice: their windows are per particle. From frame 20 only the keyframe at 28
+  // can be steered: its windows alone, the last the scene's own controls.
   const Scene late = strategy_scene(kCloth, R"({"kind": "per_step", "from_frame": 20})",
                                     R"({"window_frames": 3, "window_growth": 1})");
   const StagePlan late_plan = plan_stages(late);
   EXPECT_EQ(window_starts(late_plan.stages, 20), (std::vector<int>{25, 22, 20}));
   EXPECT_EQ(late_plan.stages.front().controls->kind, ControlKind::kPerStep);
+  EXPECT_FALSE(late_plan.stages.back().controls);
+  EXPECT_NE(late_plan.why.find("windows from frames 25, 22, 20 to frame 28"), std::string::npos) << late_plan.why;
   // The same scene below its threshold: one stage.
   const Scene tame = strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"window_growth": 1e12})");
   const StagePlan one = plan_stages(tame);
@@ -128,13 +137,33 @@ TEST(Strategy, ClothForcesGrowWindowsBackwardsFromTheLastKeyframe) {
   EXPECT_FALSE(one.scaled_first_step);  // a run the strategy leaves alone runs as it did without it
   EXPECT_TRUE(one.windows_on_early_end);     // ... unless its one stage stalls with evaluations left
   EXPECT_FALSE(plan.windows_on_early_end);
-  // What a stalled stage leaves: the same windows sharing it, the first half.
-  const std::vector<StageSpec> after = window_stages(tame, 101);
-  EXPECT_EQ(window_starts(after, 0), (std::vector<int>{23, 18, 8, 0, 0}));
+  // What a stalled stage leaves: the same windows sharing it.
+  std::vector<int> until;
+  const std::vector<StageSpec> after = window_stages(tame, 101, &until);
+  EXPECT_EQ(window_starts(after, 0), (std::vector<int>{7, 2, 0, 23, 18, 12, 0}));
+  EXPECT_EQ(until, plan.judged_until);
   int left = 0;
   for (const auto& s : after) left += s.max_evaluations;
   EXPECT_EQ(left, 101);
-  EXPECT_EQ(after.front().max_evaluations, 50);
+  EXPECT_EQ(after.front().max_evaluations, 25);
+}
+
+// A budget below what every window needs plans fewer windows (each keyframe keeps its shortest window and
+// the one reaching down to where its windows end), not the same windows each cut short.
+TEST(Strategy, ASmallBudgetPlansFewerWindows) {
+  const Scene scene = strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"max_evaluations": 60, "window_growth": 1})");
+  const StagePlan plan = plan_stages(scene);
+  EXPECT_EQ(window_starts(plan.stages, 0), (std::vector<int>{7, 0, 23, 12, 0}));
+  EXPECT_EQ(plan.judged_until, (std::vector<int>{12, 12, kAllKeyframes, kAllKeyframes, kAllKeyframes}));
+  int budget = 0;
+  for (const auto& s : plan.stages) {
+    budget += s.max_evaluations;
+    EXPECT_GE(s.max_evaluations, 10);  // the shortest windows 15, the others 10
+  }
+  EXPECT_EQ(budget, 60);
+  // A budget that fits them all keeps them all.
+  const Scene full = strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"max_evaluations": 84, "window_growth": 1})");
+  EXPECT_EQ(plan_stages(full).stages.size(), 7u);
 }
 
 // The growth is read from the gradient's frames: a keyframe's own frame's forces against earlier ones.
@@ -156,7 +185,9 @@ TEST(Strategy, InitialVelocitiesStartFromASearchedRigidThrowThenALattice) {
   const Scene scene = strategy_scene(kCloth, R"({"kind": "initial_velocity", "alpha": 0.5})", R"({"max_evaluations": 90})");
   const StagePlan plan = plan_stages(scene);
   EXPECT_TRUE(plan.scaled_first_step);
-  EXPECT_EQ(plan.throw_search, automatic_throw_count(scene.cloth->nx * scene.cloth->ny, scene.time.steps()));
+  // The automatic search, at most twice the budget in throws.
+  EXPECT_EQ(automatic_throw_count(scene.cloth->nx * scene.cloth->ny, scene.time.steps()), 512);
+  EXPECT_EQ(plan.throw_search, 180);
   const auto& stages = plan.stages;
   ASSERT_EQ(stages.size(), 3u);
   ASSERT_TRUE(stages[0].controls);
