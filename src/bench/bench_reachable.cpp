@@ -10,6 +10,7 @@
 #include "bench/bench_point.h"
 #include "bench/bench_reachable.h"
 #include "bench/job_deadline.h"
+#include "bench/worst_keyframe.h"
 #include "app/optimize_job.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -162,7 +163,6 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
     const nlohmann::json& report = run.report;
     const bool cut = run.cut;
     const double seconds = run.seconds;
-    const nlohmann::json* worst = nullptr;
     if (report.is_null()) {  // cut before its first evaluation: a failure with nothing measured
       ++rows;
       count_scene(tally[kind], false, 0, run, all_seconds, all_cpu);
@@ -172,10 +172,7 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
       t.write(out / "reachable.csv");
       continue;
     }
-    for (const auto& k : report.at("keyframe_errors"))
-      if (k.at("judged").get<bool>() &&
-          (!worst || k.at("miss_after").get<double>() > worst->at("miss_after").get<double>()))
-        worst = &k;
+    const nlohmann::json* worst = worst_judged_keyframe(report);
     if (!worst) continue;
     const bool pass = !cut && report.at("diagnosis").at("reached").get<bool>() && run.cpu_seconds <= o.pass_seconds;
     const int evaluations = report.at("evaluations").get<int>();

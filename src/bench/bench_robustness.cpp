@@ -6,10 +6,12 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 
 #include "bench/bench_point.h"
 #include "bench/bench_sweeps.h"
 #include "bench/job_deadline.h"
+#include "bench/worst_keyframe.h"
 #include "app/optimize_job.h"
 #include "report/plot.h"
 #include "core/atomic_file.h"
@@ -40,6 +42,38 @@ std::string strategy_of(const nlohmann::json& report) {
 
 extern "C" void ignore_hangup(int) {}
 
+struct SuiteJob {
+  OptimizeOutcome outcome;
+  bool cut = false;  // the job's CPU or wall deadline fired
+  double seconds = 0, cpu_seconds = 0;
+};
+
+// Optimises one scene under the suite's deadlines; nothing (and a "skipped" line in the summary) when the
+// scene is refused as input.
+std::optional<SuiteJob> run_suite_job(const RobustnessSweepOptions& o, const std::string& name,
+                                      const std::filesystem::path& file, nlohmann::json& summary) {
+  OptimizeOptions opt;
+  opt.out = (o.runs_dir / name).string();
+  opt.quiet = true;
+  opt.max_evaluations = o.max_evaluations;
+  if (o.max_seconds > 0) opt.max_seconds = o.max_seconds;
+  const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = process_cpu_seconds();
+  SuiteJob job;
+  try {
+    JobDeadline deadline(o.pass_seconds, o.wall_seconds);
+    job.outcome = optimize_job(file, opt);
+    job.cut = deadline.fired();
+  } catch (const InputError& e) {
+    std::cerr << "bench robustness: skipping " << name << ": " << e.what() << std::endl;
+    summary["skipped"].push_back(name + ": " + e.what());
+    return std::nullopt;
+  }
+  job.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  job.cpu_seconds = process_cpu_seconds() - cpu_start;
+  return job;
+}
+
 }  // namespace
 
 nlohmann::json bench_robustness(const RobustnessSweepOptions& o, const std::filesystem::path& out) {
@@ -50,27 +84,12 @@ nlohmann::json bench_robustness(const RobustnessSweepOptions& o, const std::file
   int passed = 0, rows = 0;
   for (const std::string& name : suite_scenes(o)) {
     const std::filesystem::path file = o.scene_dir / (name + ".json");
-    OptimizeOptions opt;
-    opt.out = (o.runs_dir / name).string();
-    opt.quiet = true;
-    opt.max_evaluations = o.max_evaluations;
-    if (o.max_seconds > 0) opt.max_seconds = o.max_seconds;
     std::cerr << "bench robustness: " << name << std::endl;
-    const auto start = std::chrono::steady_clock::now();
-    const double cpu_start = process_cpu_seconds();
-    OptimizeOutcome outcome;
-    bool cut = false;
-    try {
-      JobDeadline deadline(o.pass_seconds, o.wall_seconds);
-      outcome = optimize_job(file, opt);
-      cut = deadline.fired();
-    } catch (const InputError& e) {
-      std::cerr << "bench robustness: skipping " << name << ": " << e.what() << std::endl;
-      summary["skipped"].push_back(name + ": " + e.what());
-      continue;
-    }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const double cpu_seconds = process_cpu_seconds() - cpu_start;
+    const std::optional<SuiteJob> job = run_suite_job(o, name, file, summary);
+    if (!job) continue;
+    const OptimizeOutcome& outcome = job->outcome;
+    const bool cut = job->cut;
+    const double seconds = job->seconds, cpu_seconds = job->cpu_seconds;
     if (!std::filesystem::exists(outcome.dir / "report.json")) {  // cut before its first evaluation
       ++rows;
       t.add({name, "", "", "", "", "", "", "", "", "0", fmt(seconds), fmt(cpu_seconds), "cut before its first evaluation",
@@ -83,11 +102,7 @@ nlohmann::json bench_robustness(const RobustnessSweepOptions& o, const std::file
     ensure_directory(out / "reports");
     write_file_atomic(out / "reports" / (name + ".json"), report.dump(1) + "\n");
     // The scene's worst keyframe (by its miss after the optimisation) stands for it in the table.
-    const nlohmann::json* worst = nullptr;
-    for (const auto& k : report.at("keyframe_errors"))
-      if (k.at("judged").get<bool>() &&
-          (!worst || k.at("miss_after").get<double>() > worst->at("miss_after").get<double>()))
-        worst = &k;
+    const nlohmann::json* worst = worst_judged_keyframe(report);
     if (!worst) continue;
     const bool pass = !cut && report.at("diagnosis").at("reached").get<bool>() && cpu_seconds <= o.pass_seconds;
     passed += pass;

@@ -161,6 +161,35 @@ double gradient_growth(Problem& problem, const VecX& z, int reference) {
   return ref > 0 ? largest / ref : std::numeric_limits<double>::infinity();
 }
 
+namespace {
+
+// Initial velocities: a search over rigid throws, the best rigid throw, a 3 x 3 lattice from it, then one
+// velocity per particle.
+void plan_throw(const Scene& scene, StagePlan& plan) {
+  const OptimizerSpec& o = scene.optimizer;
+  const ControlSpec& c = scene.controls;
+  ControlSpec rigid = c;
+  rigid.kind = ControlKind::kInitialRigidVelocity;
+  const int rigid_budget = std::clamp(o.max_evaluations / 3, 1, 40);
+  ControlSpec lattice = c;
+  lattice.kind = ControlKind::kInitialLatticeVelocity;
+  const int lattice_budget = std::clamp((o.max_evaluations - rigid_budget) / 3, 0, 60);
+  plan.stages = {{scene.time.substeps, rigid_budget, rigid}};
+  if (lattice_budget > 0) plan.stages.push_back({scene.time.substeps, lattice_budget, lattice});
+  plan.stages.push_back({scene.time.substeps, o.max_evaluations - rigid_budget - lattice_budget, std::nullopt});
+  // The automatic search spends at most twice the budget in throws (each a simulation without its adjoint
+  // pass): a budget the user cut cuts the search too.
+  plan.throw_search = o.throw_search >= 0 ? o.throw_search
+                                          : std::min(automatic_throw_count(scene.cloth->particles(), scene.time.steps()),
+                                                     2 * o.max_evaluations);
+  plan.why = "stages: a search over " + std::to_string(plan.throw_search) +
+             " rigid throws, the best rigid throw (6 variables), a 3 x 3 lattice of initial velocities over the "
+             "sheet from it, then one initial velocity per particle";
+  plan.scaled_first_step = true;
+}
+
+}  // namespace
+
 StagePlan plan_stages(const Scene& scene) {
   const OptimizerSpec& o = scene.optimizer;
   StagePlan plan;
@@ -174,24 +203,7 @@ StagePlan plan_stages(const Scene& scene) {
   if (o.strategy == StagingStrategy::kSingle || !scene.cloth || o.max_evaluations < 2) return plan;
   const ControlSpec& c = scene.controls;
   if (c.kind == ControlKind::kInitialVelocity) {
-    ControlSpec rigid = c;
-    rigid.kind = ControlKind::kInitialRigidVelocity;
-    const int rigid_budget = std::clamp(o.max_evaluations / 3, 1, 40);
-    ControlSpec lattice = c;
-    lattice.kind = ControlKind::kInitialLatticeVelocity;
-    const int lattice_budget = std::clamp((o.max_evaluations - rigid_budget) / 3, 0, 60);
-    plan.stages = {{scene.time.substeps, rigid_budget, rigid}};
-    if (lattice_budget > 0) plan.stages.push_back({scene.time.substeps, lattice_budget, lattice});
-    plan.stages.push_back({scene.time.substeps, o.max_evaluations - rigid_budget - lattice_budget, std::nullopt});
-    // The automatic search spends at most twice the budget in throws (each a simulation without its adjoint
-    // pass): a budget the user cut cuts the search too.
-    plan.throw_search = o.throw_search >= 0 ? o.throw_search
-                                            : std::min(automatic_throw_count(scene.cloth->particles(), scene.time.steps()),
-                                                       2 * o.max_evaluations);
-    plan.why = "stages: a search over " + std::to_string(plan.throw_search) +
-               " rigid throws, the best rigid throw (6 variables), a 3 x 3 lattice of initial velocities over the "
-               "sheet from it, then one initial velocity per particle";
-    plan.scaled_first_step = true;
+    plan_throw(scene, plan);
     return plan;
   }
   if (c.kind != ControlKind::kPerStep && c.kind != ControlKind::kPerFrame) return plan;

@@ -83,7 +83,9 @@ void expect_budget_run_ends_at_least_as_close(const std::string& kind, int index
   const auto [budget_miss, budget_evaluations] = worst_miss(dir.path() / "budget");
   const auto [cut_miss, cut_evaluations] = worst_miss(dir.path() / "cut");
   EXPECT_LE(budget_evaluations, kBudget);
-  EXPECT_LE(cut_evaluations, kBudget);
+  // The signal is sent after the 60th evaluation's line; one more evaluation may finish before it lands, which
+  // only favours the cut run.
+  EXPECT_LE(cut_evaluations, kBudget + 1);
   EXPECT_LE(budget_miss, std::max(cut_miss, 1.0)) << "budget " << budget_miss << " tolerances after " << budget_evaluations
                                                   << " evaluations; cut full run " << cut_miss << " after " << cut_evaluations;
   std::cout << kind << "-" << index << ": budget " << budget_miss << " after " << budget_evaluations << ", cut " << cut_miss
