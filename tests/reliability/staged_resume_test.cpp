@@ -88,14 +88,14 @@ const char* const kThrow = R"({"time": {"fps": 30, "frames": 20},
   "optimizer": {"max_evaluations": 24, "throw_search": 16}})";
 
 // A 6 x 6 sheet dropped on a sphere with per-frame forces: lattice windows from frames 15, 10 and 0, then one
-// force per particle (four stages).
+// force per particle (four stages; the budget gives each stage the twelve evaluations a planned window needs).
 const char* const kDrop = R"({"time": {"fps": 30, "frames": 20},
   "cloth": {"nx": 6, "ny": 6, "width": 1.0, "height": 1.0, "mass": 0.3, "origin": [-0.5, 0.9, -0.5],
             "u_axis": [1, 0, 0], "v_axis": [0, 0, 1],
             "colliders": [{"type": "sphere", "center": [0, 0.5, 0], "radius": 0.3}, {"type": "ground"}]},
   "objectives": [{"type": "center_of_mass", "frame": 20, "target": [0.1, 0.5, 0]}],
   "controls": {"kind": "per_frame"},
-  "optimizer": {"max_evaluations": 24, "stop_when_reached": false}})";  // every stage runs, to be cut
+  "optimizer": {"max_evaluations": 48, "stop_when_reached": false}})";  // every stage runs, to be cut
 
 struct StagedCase {
   const char* name;
