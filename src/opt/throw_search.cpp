@@ -78,4 +78,25 @@ ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted
   return s;
 }
 
+ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int count, int budget,
+                                  const std::atomic<bool>* stop) {
+  constexpr int kThrowCorrections = 3;  // four flights, a small share of the search
+  const FittedThrow fitted = refine_fitted_throw(problem, scene, kThrowCorrections);
+  ThrowSearch s = search_throws(problem, std::min(count, std::max(0, budget - fitted.simulated)), fitted, stop);
+  std::vector<VecX> starts = {s.z};
+  for (const VecX& z : {VecX(VecX::Zero(6)), fitted.z ? *fitted.z : VecX::Zero(6)})
+    if (std::none_of(starts.begin(), starts.end(), [&](const VecX& a) { return a == z; })) starts.push_back(z);
+  RigidFitOptions o;
+  o.max_simulations = std::max(0, budget - s.simulated);
+  o.stop = stop;
+  s.rigid = fit_rigid_throw(problem, scene, starts, o);
+  s.simulated += s.rigid->simulated;
+  if (s.rigid->z.size() == 6) {
+    const double phi = problem.evaluate(s.rigid->z, nullptr);
+    ++s.simulated;
+    if (!problem.last_diverged() && phi < s.phi) s.phi = phi, s.z = s.rigid->z;
+  }
+  return s;
+}
+
 }  // namespace kf
