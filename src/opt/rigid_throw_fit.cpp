@@ -251,6 +251,19 @@ const char* stop_name(RigidFitStop s) {
 
 }  // namespace
 
+void absorb(RigidThrowFit& into, const RigidThrowFit& more) {
+  into.simulated += more.simulated;
+  into.starts += more.starts;
+  into.stops.insert(into.stops.end(), more.stops.begin(), more.stops.end());
+  into.start_costs.insert(into.start_costs.end(), more.start_costs.begin(), more.start_costs.end());
+  into.end_costs.insert(into.end_costs.end(), more.end_costs.begin(), more.end_costs.end());
+  if (more.z.size() == 6 && (into.z.size() != 6 || more.cost < into.cost)) {
+    into.z = more.z;
+    into.cost = more.cost;
+    into.worst_miss = more.worst_miss;
+  }
+}
+
 std::string describe(const RigidThrowFit& fit) {
   std::ostringstream os;
   os << std::setprecision(3) << "rigid Levenberg-Marquardt from " << fit.starts << " start" << (fit.starts == 1 ? "" : "s")

@@ -51,6 +51,9 @@ struct RigidFitOptions {
 RigidThrowFit fit_rigid_throw(Problem& problem, const Scene& scene, const std::vector<VecX>& starts,
                               const RigidFitOptions& options);
 
+// Adds the fit `more` (from other starts) to `into`: its starts, flights and, when better, its point.
+void absorb(RigidThrowFit& into, const RigidThrowFit& more);
+
 // One line for the run's log: the starts, how each ended, the flights and the worst miss reached.
 std::string describe(const RigidThrowFit& fit);
 

@@ -81,21 +81,31 @@ ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted
 ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int count, int budget,
                                   const std::atomic<bool>* stop) {
   constexpr int kThrowCorrections = 3;  // four flights, a small share of the search
+  constexpr int kFirstFit = 100;        // flights for the fit from the scene's and the fitted throw: a few Jacobians
   const FittedThrow fitted = refine_fitted_throw(problem, scene, kThrowCorrections);
-  ThrowSearch s = search_throws(problem, std::min(count, std::max(0, budget - fitted.simulated)), fitted, stop);
-  std::vector<VecX> starts = {s.z};
-  for (const VecX& z : {VecX(VecX::Zero(6)), fitted.z ? *fitted.z : VecX::Zero(6)})
-    if (std::none_of(starts.begin(), starts.end(), [&](const VecX& a) { return a == z; })) starts.push_back(z);
   RigidFitOptions o;
-  o.max_simulations = std::max(0, budget - s.simulated);
   o.stop = stop;
-  s.rigid = fit_rigid_throw(problem, scene, starts, o);
-  s.simulated += s.rigid->simulated;
-  if (s.rigid->z.size() == 6) {
-    const double phi = problem.evaluate(s.rigid->z, nullptr);
-    ++s.simulated;
-    if (!problem.last_diverged() && phi < s.phi) s.phi = phi, s.z = s.rigid->z;
+  o.max_simulations = std::clamp(budget - fitted.simulated, 0, kFirstFit);
+  std::vector<VecX> starts = {VecX::Zero(6)};
+  if (fitted.z && *fitted.z != starts[0]) starts.push_back(*fitted.z);
+  RigidThrowFit rigid = fit_rigid_throw(problem, scene, starts, o);
+  // A throw the fit brought to the keyframes needs no search (the scene's throw is still flown, once).
+  const int spent = fitted.simulated + rigid.simulated;
+  const int searched = rigid.reached() ? 0 : std::min(count, std::max(0, budget - spent));
+  ThrowSearch s = search_throws(problem, searched, fitted, stop);
+  s.simulated += rigid.simulated;
+  if (!rigid.reached() && s.z.size() == 6 && std::none_of(starts.begin(), starts.end(), [&](const VecX& a) { return a == s.z; })) {
+    o.max_simulations = std::clamp(budget - s.simulated, 0, std::max(count, 1));  // at most the search's time again
+    const RigidThrowFit more = fit_rigid_throw(problem, scene, {s.z}, o);
+    s.simulated += more.simulated;
+    absorb(rigid, more);
   }
+  if (rigid.z.size() == 6) {
+    const double phi = problem.evaluate(rigid.z, nullptr);
+    ++s.simulated;
+    if (!problem.last_diverged() && phi < s.phi) s.phi = phi, s.z = rigid.z;
+  }
+  s.rigid = rigid;
   return s;
 }
 

@@ -36,10 +36,10 @@ int automatic_throw_count(int particles, int steps);
 ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted = {},
                           const std::atomic<bool>* stop = nullptr);
 
-// What runs before a rigid first stage: the search (count throws, the fitted throw among them), then
-// Levenberg–Marquardt on the six rigid variables (opt/rigid_throw_fit.h) from the search's best, then from the
-// scene's throw and the fitted one, until one meets the keyframes or `budget` flights in all are spent.
-// The result's z is the best point of both, by φ.
+// What runs before a rigid first stage: Levenberg–Marquardt on the six rigid variables (opt/rigid_throw_fit.h)
+// from the scene's throw and the throw fitted to the keyframes; when that does not meet them, the search
+// (`count` throws) and the fit again from its best, flying at most as many throws as the search did. `budget`
+// caps every flight together. The result's z is the best point of all, by φ.
 ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int count, int budget,
                                   const std::atomic<bool>* stop = nullptr);
 
