@@ -85,17 +85,19 @@ ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int coun
   const FittedThrow fitted = refine_fitted_throw(problem, scene, kThrowCorrections);
   RigidFitOptions o;
   o.stop = stop;
-  o.max_simulations = std::clamp(budget - fitted.simulated, 0, kFirstFit);
+  // Each fit flies at most a quarter of the search's throws: `count` is what a large sheet's time allows.
+  const int quarter = std::max(1, count / 4);
+  o.max_simulations = std::clamp(budget - fitted.simulated, 0, std::min(kFirstFit, quarter));
   std::vector<VecX> starts = {VecX::Zero(6)};
   if (fitted.z && *fitted.z != starts[0]) starts.push_back(*fitted.z);
   RigidThrowFit rigid = fit_rigid_throw(problem, scene, starts, o);
   // A throw the fit brought to the keyframes needs no search (the scene's throw is still flown, once).
   const int spent = fitted.simulated + rigid.simulated;
-  const int searched = rigid.reached() ? 0 : std::min(count, std::max(0, budget - spent));
+  const int searched = rigid.reached() ? 0 : std::max(0, std::min(count - rigid.simulated, budget - spent));
   ThrowSearch s = search_throws(problem, searched, fitted, stop);
   s.simulated += rigid.simulated;
   if (!rigid.reached() && s.z.size() == 6 && std::none_of(starts.begin(), starts.end(), [&](const VecX& a) { return a == s.z; })) {
-    o.max_simulations = std::clamp(budget - s.simulated, 0, std::max(count, 1));  // at most the search's time again
+    o.max_simulations = std::clamp(budget - s.simulated, 0, quarter);
     const RigidThrowFit more = fit_rigid_throw(problem, scene, {s.z}, o);
     s.simulated += more.simulated;
     absorb(rigid, more);

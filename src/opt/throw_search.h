@@ -38,8 +38,9 @@ ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted
 
 // What runs before a rigid first stage: Levenberg–Marquardt on the six rigid variables (opt/rigid_throw_fit.h)
 // from the scene's throw and the throw fitted to the keyframes; when that does not meet them, the search
-// (`count` throws) and the fit again from its best, flying at most as many throws as the search did. `budget`
-// caps every flight together. The result's z is the best point of all, by φ.
+// (`count` throws less the fit's flights) and the fit again from its best. Each fit flies at most a quarter of
+// `count` (at most 100 the first), so all of it takes about the search's time; `budget` caps every flight
+// together. The result's z is the best point of all, by φ.
 ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int count, int budget,
                                   const std::atomic<bool>* stop = nullptr);
 
