@@ -10,6 +10,10 @@ if len(sys.argv) != 4:
     raise SystemExit(__doc__)
 
 
+def num(v, fmt):
+    return fmt % float(v) if v != "" else "–"  # a job cut before its first evaluation measured nothing
+
+
 def rows(files):
     return {r["scene"]: r for f in files.split(",") for r in csv.DictReader(open(f))}
 
@@ -23,8 +27,8 @@ with open(sys.argv[1], "w", newline="") as out:
     w.writerow(fields)
     for n in names:
         b, a = before[n], after[n]
-        w.writerow([n, "%.2f" % float(a["miss_before"]), "%.3g" % float(b["miss_after"]), b["pass"],
-                    "%.1f" % float(b["cpu_seconds"]), "%.3g" % float(a["miss_after"]), a["pass"], a["evaluations"],
+        w.writerow([n, num(b["miss_before"], "%.2f"), num(b["miss_after"], "%.3g"), b["pass"],
+                    "%.1f" % float(b["cpu_seconds"]), num(a["miss_after"], "%.3g"), a["pass"], a["evaluations"],
                     "%.1f" % float(a["cpu_seconds"]), a["outcome"]])
     cb = [float(before[n]["cpu_seconds"]) for n in names]
     ca = [float(after[n]["cpu_seconds"]) for n in names]
