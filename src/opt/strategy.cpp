@@ -203,12 +203,11 @@ bool rehold_schedule(StrategyResult& r, const VecX& z, double& phi) {
 // while the throws differ, then the best one's schedule is held. Deterministic, so a resume that replays
 // the run's evaluations searches again and starts where the run did.
 void search_throws_first(Run& run) {
-  constexpr int kThrowCorrections = 3;  // four flights, a small share of the search
   StrategyResult& r = run.r;
   r.sys->release_step_schedule();
   const auto t0 = std::chrono::steady_clock::now();
-  const ThrowSearch found = search_throws(*r.problem, run.plan.throw_search,
-                                          refine_fitted_throw(*r.problem, run.scene, kThrowCorrections), run.stop);
+  const ThrowSearch found = search_and_fit_throws(*r.problem, run.scene, run.plan.throw_search,
+                                                  2 * run.scene.optimizer.max_evaluations, run.stop);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::ostringstream os;
   os << std::setprecision(3) << "throw search: " << found.simulated << " rigid throws simulated (speeds within "
@@ -220,6 +219,7 @@ void search_throws_first(Run& run) {
     os << "; the throw fitted to the keyframes " << found.fitted.front();
     for (size_t k = 1; k < found.fitted.size(); ++k) os << (k == 1 ? ", corrected " : ", ") << found.fitted[k];
   }
+  if (found.rigid) os << "; " << describe(*found.rigid);
   run.log.say(os.str());
   r.throw_search = found;
   r.throw_seconds = seconds;

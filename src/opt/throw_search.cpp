@@ -78,4 +78,37 @@ ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted
   return s;
 }
 
+ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int count, int budget,
+                                  const std::atomic<bool>* stop) {
+  constexpr int kThrowCorrections = 3;  // four flights, a small share of the search
+  constexpr int kFirstFit = 100;        // flights for the fit from the scene's and the fitted throw: a few Jacobians
+  const FittedThrow fitted = refine_fitted_throw(problem, scene, kThrowCorrections);
+  RigidFitOptions o;
+  o.stop = stop;
+  // Each fit flies at most a quarter of the search's throws: `count` is what a large sheet's time allows.
+  const int quarter = std::max(1, count / 4);
+  o.max_simulations = std::clamp(budget - fitted.simulated, 0, std::min(kFirstFit, quarter));
+  std::vector<VecX> starts = {VecX::Zero(6)};
+  if (fitted.z && *fitted.z != starts[0]) starts.push_back(*fitted.z);
+  RigidThrowFit rigid = fit_rigid_throw(problem, scene, starts, o);
+  // A throw the fit brought to the keyframes needs no search (the scene's throw is still flown, once).
+  const int spent = fitted.simulated + rigid.simulated;
+  const int searched = rigid.reached() ? 0 : std::max(0, std::min(count - rigid.simulated, budget - spent));
+  ThrowSearch s = search_throws(problem, searched, fitted, stop);
+  s.simulated += rigid.simulated;
+  if (!rigid.reached() && s.z.size() == 6 && std::none_of(starts.begin(), starts.end(), [&](const VecX& a) { return a == s.z; })) {
+    o.max_simulations = std::clamp(budget - s.simulated, 0, quarter);
+    const RigidThrowFit more = fit_rigid_throw(problem, scene, {s.z}, o);
+    s.simulated += more.simulated;
+    absorb(rigid, more);
+  }
+  if (rigid.z.size() == 6) {
+    const double phi = problem.evaluate(rigid.z, nullptr);
+    ++s.simulated;
+    if (!problem.last_diverged() && phi < s.phi) s.phi = phi, s.z = rigid.z;
+  }
+  s.rigid = rigid;
+  return s;
+}
+
 }  // namespace kf

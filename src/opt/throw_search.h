@@ -9,6 +9,7 @@
 
 #include "core/types.h"
 #include "opt/problem.h"
+#include "opt/rigid_throw_fit.h"
 #include "opt/throw_fit.h"
 
 namespace kf {
@@ -21,6 +22,7 @@ struct ThrowSearch {
   std::vector<double> fitted;  // the objectives of the fitted throw and its corrections (opt/throw_fit.h)
   double speed = 0;        // the box's half-width in Δv (m/s)
   double spin = 0;         // and in ω (rad/s)
+  std::optional<RigidThrowFit> rigid;  // Levenberg–Marquardt on (Δv, ω) after the search (search_and_fit_throws)
 };
 
 // How many throws the automatic search simulates for a sheet of `particles` over `steps` steps: about four
@@ -33,5 +35,13 @@ int automatic_throw_count(int particles, int steps);
 // A set *stop ends the search after the throw being simulated, with the best so far.
 ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted = {},
                           const std::atomic<bool>* stop = nullptr);
+
+// What runs before a rigid first stage: Levenberg–Marquardt on the six rigid variables (opt/rigid_throw_fit.h)
+// from the scene's throw and the throw fitted to the keyframes; when that does not meet them, the search
+// (`count` throws less the fit's flights) and the fit again from its best. Each fit flies at most a quarter of
+// `count` (at most 100 the first), so all of it takes about the search's time; `budget` caps every flight
+// together. The result's z is the best point of all, by φ.
+ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int count, int budget,
+                                  const std::atomic<bool>* stop = nullptr);
 
 }  // namespace kf
