@@ -23,6 +23,7 @@ for f in "$out"/*.json; do
   n=$(basename "$f" .json)
   nice -n 10 build/release/keyframe --threads 1 optimize "$f" --out "$out/runs/$n" --quiet > "$out/$n.log" 2>&1 || true
 done
+for f in "$out"/*.log; do echo "$(basename "$f" .log): $(grep '^keyframe' "$f")"; done > "$out/diagnoses.txt"  # friction_off_diagnoses.txt
 python3 - "$out" <<'PY'
 import json, sys, glob, os
 print("scene,evaluations,status,keyframe,error_uncontrolled,error_optimised,met")
