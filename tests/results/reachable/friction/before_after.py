@@ -8,9 +8,12 @@ before = {}
 for f in glob.glob(os.path.join(here, "..", "ordered-*", "reachable.csv")):
     for r in csv.DictReader(open(f)):
         before[r["scene"]] = r
-after = []
+after, seen = [], set()  # a scene measured twice (the same controls both times) is listed once
 for f in sorted(glob.glob(os.path.join(here, "*", "reachable.csv"))):
-    after += list(csv.DictReader(open(f)))
+    for r in csv.DictReader(open(f)):
+        if r["scene"] not in seen:
+            seen.add(r["scene"])
+            after.append(r)
 # Each side's worst keyframe (in tolerances), uncontrolled and optimised.
 cols = ["scene", "friction", "keyframes", "keyframe_before", "uncontrolled_before", "miss_before", "outcome_before",
         "pass_before", "keyframe_after", "uncontrolled_after", "miss_after", "evaluations_after", "cpu_seconds_after",
