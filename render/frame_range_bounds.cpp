@@ -4,6 +4,7 @@
 
 #include "core/error.h"
 #include "core/overloaded.h"
+#include "render/geometry/height_target.h"
 
 namespace kf::render {
 
@@ -28,7 +29,10 @@ Bounds frame_range_bounds(const Scene& scene, const Trajectory& traj, const Mesh
                    [&](const ShapeKeyframe& k) { for (const Vec2& q : k.polygon) b.add(Vec3(q.x(), 0.0, q.y())); },
                    [](const VelocityKeyframe&) {},  // a velocity is no place
                    [](const ArchKeyframe&) {},
-                   [](const HeightKeyframe&) {},  // a height alone is no point in space
+                   [&](const HeightKeyframe& k) {  // its outline around the particles at its frame
+                     for (const Vec3& q : height_target_outline(o, k, traj.x[size_t(o.frame)], traj.particles, 0.0))
+                       b.add(q);
+                   },
                },
                o.kind);
   }

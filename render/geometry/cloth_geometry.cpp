@@ -4,6 +4,7 @@
 #include "core/check.h"
 #include "core/box_frame.h"
 #include "core/overloaded.h"
+#include "render/geometry/height_target.h"
 #include "render/geometry/primitives.h"
 #include "render/geometry/system_geometry.h"
 
@@ -142,9 +143,15 @@ void build_cloth(const Scene& scene, const Trajectory& traj, int f, double scale
   for (const auto& c : scene.cloth->colliders) add_collider(m, c.shape, rs.collider_color);
   // Targets of the keyframes still to come, small beside their own spacing so a sheet of targets does
   // not hide the cloth that reaches it. A blend's end target (a whole other take's cape) is drawn at its
-  // own frame only: over the cape in every frame it would hide the blend.
+  // own frame only: over the cape in every frame it would hide the blend. A height's target is a thin
+  // level outline around its particles.
   size_t markers = 0;
   for (const auto& o : scene.objectives) {
+    if (const auto* height = std::get_if<HeightKeyframe>(&o.kind); height && o.frame >= f) {
+      const std::vector<Vec3> outline = height_target_outline(o, *height, traj.x[f], traj.particles, 0.05 * scale);
+      if (!outline.empty()) add_ribbon(m, outline, true, 0.006 * scale, Vec3::UnitY(), rs.target_color);
+      continue;
+    }
     const auto* position = std::get_if<PositionKeyframe>(&o.kind);
     if (!position || o.frame < f || position->targets.empty()) continue;
     if (o.source == ObjectiveSource::kEndTarget && o.frame != f) continue;

@@ -8,6 +8,7 @@
 
 #include "core/check.h"
 #include "core/overloaded.h"
+#include "render/geometry/height_target.h"
 #include "render/geometry/primitives.h"
 #include "render/geometry/system_geometry.h"
 
@@ -99,7 +100,10 @@ Bounds scene_bounds(const Scene& scene, const Trajectory& traj, const MeshSequen
                    [&](const CenterOfMassKeyframe& k) { b.add(k.target); },
                    [&](const ShapeKeyframe& k) { for (const Vec2& q : k.polygon) b.add(Vec3(q.x(), 0.0, q.y())); },
                    [](const ArchKeyframe&) {},
-                   [](const HeightKeyframe&) {},  // a height alone is no point in space
+                   [&](const HeightKeyframe& k) {  // its outline around the particles at its frame
+                     const VecX& x = traj.x[size_t(std::min(o.frame, traj.frames() - 1))];
+                     for (const Vec3& q : height_target_outline(o, k, x, traj.particles, 0.0)) b.add(q);
+                   },
                },
                o.kind);
   if (scene.cloth)

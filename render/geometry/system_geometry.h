@@ -7,7 +7,7 @@ namespace kf::render {
 // Frame f of a flock: agents on the ground plane, shape keyframes, centre-of-mass path, racer circles.
 void build_flock(const Scene& scene, const Trajectory& traj, int f, double scale, const GroundPlane& plane,
                  FrameGeometry& g);
-// Frame f of a cloth: the two-sided sheet, its colliders and the position targets still to come.
+// Frame f of a cloth: the two-sided sheet, its colliders and the position and height targets still to come.
 void build_cloth(const Scene& scene, const Trajectory& traj, int f, double scale, FrameGeometry& g);
 // A collider's surface as triangles (nothing for a ground: see add_ground_square).
 void add_collider(Mesh& m, const ColliderShape& shape, const Vec3& color);

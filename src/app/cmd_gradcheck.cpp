@@ -34,7 +34,7 @@ struct GradcheckCommandOptions {
 Scene gradcheck_scene(const GradcheckCommandOptions& o) {
   Scene scene = shortened(load_scene(o.scene), o.frames);
   if (o.substeps > 0) scene.time.substeps = o.substeps;
-  if (!o.adjoint.empty()) scene.optimizer.adjoint = o.adjoint;
+  if (!o.adjoint.empty()) scene.optimizer.adjoint = adjoint_kind(o.adjoint);
   if (scene.cloth && o.solver == "direct") scene.cloth->solver = "direct";
   if (o.dt > 0) {
     const double n = 1.0 / (scene.time.fps * o.dt);
@@ -96,7 +96,7 @@ void run_gradcheck(const GradcheckCommandOptions& o) {
   j["control_variables"] = problem.size();
   if (o.line > 0) j["line"] = objective_along_descent(problem, z, o.line);
   if (scene.cloth) {
-    j["adjoint"] = scene.optimizer.adjoint;
+    j["adjoint"] = adjoint_name(scene.optimizer.adjoint);
     j["solver"] = scene.cloth->solver;
   }
   std::cout << j.dump() << "\n";
@@ -133,7 +133,7 @@ void add_gradcheck_options(CLI::App* sub, const std::shared_ptr<GradcheckCommand
   sub->add_option("--seed", o->seed, "seed for the sample and the controls")->capture_default_str();
   sub->add_option("--adjoint", o->adjoint, "cloth adjoint: exact (the step's own Jacobian) or swap (the paper's "
                                            "integrator swap); default: the scene's optimizer.adjoint")
-      ->check(CLI::IsMember({"exact", "swap"}));
+      ->check(CLI::IsMember(adjoint_names()));
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include "app/commands.h"
 #include "app/optimize_job.h"
 #include "core/error.h"
+#include "scene/solver_choices.h"
 
 namespace kf {
 
@@ -25,7 +26,7 @@ void add_optimize_options(CLI::App* sub, OptimizeOptions& o) {
   sub->add_option("--adjoint", o.adjoint,
                   "override the scene's optimizer.adjoint for cloth: exact (the transpose of the step's own "
                   "Jacobian) or swap (the paper's integrator-swapping approximation)")
-      ->check(CLI::IsMember({"exact", "swap"}));
+      ->check(CLI::IsMember(adjoint_names()));
   sub->add_flag("--quiet", o.quiet, "no line per evaluation, only a progress display");
 }
 

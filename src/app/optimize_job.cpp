@@ -72,7 +72,7 @@ std::size_t rollout_budget(const Problem& problem, System& sys, int lbfgs_memory
 // The scene of a new run or of the run being resumed, with the command line's overrides.
 Scene job_scene(const fs::path& scene_file, const OptimizeOptions& opt) {
   Scene scene = !opt.resume.empty() ? load_run_scene(opt.resume) : load_scene(scene_file);
-  if (!opt.adjoint.empty()) scene.optimizer.adjoint = opt.adjoint;
+  if (!opt.adjoint.empty()) scene.optimizer.adjoint = adjoint_kind(opt.adjoint);
   if (opt.max_seconds >= 0) scene.optimizer.max_seconds = opt.max_seconds;
   if (opt.stop_when_reached >= 0) scene.optimizer.stop_when_reached = opt.stop_when_reached > 0;
   resolve_uncontrolled_offsets(scene);

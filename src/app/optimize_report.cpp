@@ -12,6 +12,7 @@
 #include "core/atomic_file.h"
 #include "core/trajectory.h"
 #include "opt/controls_file.h"
+#include "opt/term_breakdown.h"
 #include "report/cape_end_state.h"
 #include "report/figure_measures.h"
 #include "report/plot.h"
@@ -37,14 +38,6 @@ nlohmann::json throw_search_json(const ThrowSearch& found, double seconds) {
           {"fitted_objectives", found.fitted},
           {"best_throw", std::vector<double>(found.z.data(), found.z.data() + found.z.size())},
           {"seconds", seconds}};
-}
-
-// The keyframe terms of an evaluation's breakdown (φ without the effort term).
-double keyframe_terms(const std::vector<std::pair<std::string, double>>& terms) {
-  double sum = 0;
-  for (const auto& [name, value] : terms)
-    if (name != "effort") sum += value;
-  return sum;
 }
 
 // What the run shows besides its keyframes: its budget, its largest trial objective, how fast it still fell.
@@ -81,7 +74,7 @@ UncontrolledRun run_uncontrolled(const Scene& scene, StrategyResult& job) {
   Problem& problem = *job.problem;
   UncontrolledRun u;
   const double objective = problem.evaluate(problem.initial_guess(), nullptr);
-  u.keyframes = problem.last_diverged() ? objective : keyframe_terms(problem.breakdown());
+  u.keyframes = problem.last_diverged() ? objective : keyframe_terms_sum(problem);
   u.frames = frames_of(problem.rollout(), job.time, job.sys->particles());
   for (const auto& [name, value] : job.sys->run_stats()) u.stats[name] = value;
   u.measures = measure_keyframes(scene, u.frames);
@@ -119,7 +112,7 @@ nlohmann::json report_summary(const Scene& scene, bool resuming, const OptimizeR
           {"checkpoint_every", problem.checkpoint_every()},
           {"memory_budget_gb", run.memory_budget_gb},
           {"checkpoint_every_for_budget", run.auto_checkpoint_every},
-          {"adjoint", scene.optimizer.adjoint},
+          {"adjoint", adjoint_name(scene.optimizer.adjoint)},
           {"stages", job.planned_stages},
           {"resumed", resuming},
           {"replayed_evaluations", job.tape.replayed()},
@@ -138,10 +131,8 @@ void diagnose_run(const Scene& scene, OptimizeRun& run, const EvaluationLog& elo
                   const Trajectory& frames, double final_objective, nlohmann::json& report) {
   StrategyResult& job = run.strategy;
   Problem& problem = *job.problem;
-  double effort_end = 0;
-  for (const auto& [name, value] : problem.breakdown())
-    if (name == "effort") effort_end = value;
-  const double final_keyframes = problem.last_diverged() ? final_objective : keyframe_terms(problem.breakdown());
+  const double effort_end = last_effort(problem).value_or(0.0);
+  const double final_keyframes = problem.last_diverged() ? final_objective : keyframe_terms_sum(problem);
   const std::vector<KeyframeJudgement> keyframes =
       judge_keyframes(scene, before.measures, measure_keyframes(scene, frames));
   // Under the run's checkpointing and budget: keeping every step of its gradient would hold the whole tape

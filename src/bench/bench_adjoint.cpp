@@ -51,8 +51,9 @@ nlohmann::json bench_adjoint(const AdjointSweepOptions& o, const std::filesystem
       continue;
     }
     if (!scene.cloth) continue;
-    for (const char* adjoint : {"exact", "swap"}) {
-      scene.optimizer.adjoint = adjoint;
+    for (const AdjointKind adjoint_choice : {AdjointKind::kExact, AdjointKind::kSwap}) {
+      const char* adjoint = adjoint_name(adjoint_choice);
+      scene.optimizer.adjoint = adjoint_choice;
       std::cerr << "bench adjoint: " << name << " (" << adjoint << ")" << std::endl;
       BenchPointOptions po;
       po.optimize_evaluations = 100000;

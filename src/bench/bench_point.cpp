@@ -8,6 +8,7 @@
 #include "core/atomic_file.h"
 #include "opt/gradcheck.h"
 #include "opt/optimizer.h"
+#include "opt/term_breakdown.h"
 #include "sim/make_system.h"
 
 namespace kf {
@@ -16,13 +17,6 @@ namespace {
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-double keyframe_terms(const Problem& problem) {
-  double k = 0;
-  for (const auto& [name, value] : problem.breakdown())
-    if (name != "effort") k += value;
-  return k;
 }
 
 }  // namespace
@@ -45,7 +39,7 @@ BenchPoint measure_point(const Scene& scene, const BenchPointOptions& o) {
     p.gradient_s = std::min(p.gradient_s, seconds_since(t0));
   }
   p.diverged = problem.last_diverged();
-  p.keyframe_initial = keyframe_terms(problem);
+  p.keyframe_initial = keyframe_terms_sum(problem);
   if (o.gradcheck_samples > 0 && !p.diverged) {
     const GradcheckResult c = gradcheck(problem, z0, {.samples = o.gradcheck_samples, .eps = o.gradcheck_eps});
     p.gradchecked = true;
@@ -62,7 +56,7 @@ BenchPoint measure_point(const Scene& scene, const BenchPointOptions& o) {
     p.optimize_s = seconds_since(t0);
     p.evaluations = r.evaluations;
     problem.evaluate(r.z, nullptr);
-    p.keyframe_final = keyframe_terms(problem);
+    p.keyframe_final = keyframe_terms_sum(problem);
   }
   return p;
 }

@@ -10,6 +10,7 @@
 #include "opt/friction_continuation.h"
 #include "opt/keyframe_weights.h"
 #include "opt/restarts.h"
+#include "opt/term_breakdown.h"
 #include "opt/throw_fit.h"
 #include "opt/uncontrolled_floor.h"
 #include "sim/make_system.h"
@@ -392,7 +393,7 @@ void windows_after_early_end(Run& run, std::vector<StageSpec>& stages) {
 double scene_keyframe_terms(const Problem& problem) {
   const auto& terms = problem.breakdown();
   const auto& scales = problem.weight_scales();
-  if (terms.empty() || terms.back().first != "effort") return INFINITY;
+  if (!last_effort(problem)) return INFINITY;
   double sum = 0;
   for (size_t k = 0; k + 1 < terms.size(); ++k)
     if (scales.empty() || scales[k] > 0) sum += terms[k].second / (scales.empty() ? 1.0 : scales[k]);

@@ -205,7 +205,8 @@ ClothSpec parse_cloth_spec(Block& b, const std::filesystem::path& directory) {
   s.cg_tolerance_stated = b.has("cg_tolerance");
   s.cg_tolerance = b.number("cg_tolerance", s.cg_tolerance, 1e-16, 1e-1);
   s.cg_max_iterations = b.integer("cg_max_iterations", s.cg_max_iterations, 1, 1'000'000);
-  s.cg_preconditioner = b.string("cg_preconditioner", s.cg_preconditioner, {"auto", "incomplete_cholesky", "multigrid", "block_jacobi"});
+  s.cg_preconditioner = cg_preconditioner(
+      b.string("cg_preconditioner", cg_preconditioner_name(s.cg_preconditioner), cg_preconditioner_names()));
   s.solver = b.string("solver", s.solver, {"pcg", "direct"});
   s.control_integration = b.string("control_integration", s.control_integration, {"implicit", "explicit"});
   s.max_halvings = b.integer("max_halvings", s.max_halvings, 0, 16);

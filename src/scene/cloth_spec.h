@@ -12,6 +12,7 @@
 
 #include "core/types.h"
 #include "scene/cloth_mesh.h"
+#include "scene/solver_choices.h"
 
 namespace kf {
 class Block;
@@ -123,9 +124,9 @@ struct ClothSpec {
   double cg_tolerance = 1e-8;           // PCG stops when |r| <= cg_tolerance * |b| (filtered)
   bool cg_tolerance_stated = false;     // the scene gave cg_tolerance (else use_motion_tolerance may relax it)
   int cg_max_iterations = 1000;         // PCG failing to converge within this fails the step
-  // "auto" (IC(0) below 5,000 particles, multigrid from there), "incomplete_cholesky", "multigrid",
-  // "block_jacobi".
-  std::string cg_preconditioner = "auto";
+  // auto (the cloth system picks by the sheet's size), incomplete_cholesky, multigrid, block_jacobi
+  // (scene/solver_choices.h).
+  CgPreconditioner cg_preconditioner = CgPreconditioner::kAuto;
   std::string solver = "pcg";           // "direct": sparse LDL^T per step, exact to round-off
   // "implicit": control forces enter the backward-Euler solve with the springs, which filters them (a
   // force against a stiff spring barely moves it within a step). "explicit": each substep adds h u / m to
@@ -154,7 +155,7 @@ struct ClothSpec {
   int particles() const { return mesh ? mesh->particles() : nx * ny; }
   bool direct_solver() const { return solver == "direct"; }
   bool explicit_controls() const { return control_integration == "explicit"; }
-  bool block_jacobi() const { return cg_preconditioner == "block_jacobi"; }
+  bool block_jacobi() const { return cg_preconditioner == CgPreconditioner::kBlockJacobi; }
   int index(int i, int j) const { return j * nx + i; }
   // A run that takes no gradient (keyframe simulate) needs only the motion: unless the scene states
   // cg_tolerance, it solves to kMotionTolerance instead of the default, which is for gradients (their error

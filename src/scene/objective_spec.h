@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/types.h"
+#include "scene/solver_choices.h"
 
 namespace kf {
 
@@ -135,8 +136,9 @@ struct OptimizerSpec {
   // energy check chose (ClothSystem::hold_schedule), so φ has no jumps where the check flips between
   // trial points; "adaptive" checks every step of every evaluation.
   SplitSchedule split_schedule = SplitSchedule::kHeld;
-  // Cloth adjoint: "exact" (the transpose of the step's Jacobian) or "swap" (the paper's integrator swap).
-  std::string adjoint = "exact";
+  // Cloth adjoint (scene/solver_choices.h): exact (the transpose of the step's Jacobian) or swap (the paper's
+  // integrator swap).
+  AdjointKind adjoint = AdjointKind::kExact;
   // How the run is split into stages when no schedule is given (opt/windows.h): "auto" keeps every
   // gradient short on cloth (forces over windows grown backwards from the last keyframe when the gradient
   // grows across the horizon; a rigid throw before per-particle initial velocities), "single" optimises

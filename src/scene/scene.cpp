@@ -325,7 +325,7 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls, int fr
                                {"held", "adaptive"}) == "held"
                          ? SplitSchedule::kHeld
                          : SplitSchedule::kAdaptive;
-  o.adjoint = b.string("adjoint", o.adjoint, {"exact", "swap"});
+  o.adjoint = adjoint_kind(b.string("adjoint", adjoint_name(o.adjoint), adjoint_names()));
   o.strategy = b.string("strategy", o.strategy == StagingStrategy::kAuto ? "auto" : "single", {"auto", "single"}) == "auto"
                    ? StagingStrategy::kAuto
                    : StagingStrategy::kSingle;

@@ -9,15 +9,11 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
-#include "../reliability/cli_harness.h"
+#include "../support/cli_test.h"
 
 namespace kf {
 namespace {
-namespace fs = std::filesystem;
-using reliability::read_text;
-using reliability::run_keyframe;
-using reliability::TempDirTest;
-using Json = nlohmann::json;
+using namespace cli_test;
 
 class BoxColliderCli : public TempDirTest {};
 

@@ -14,15 +14,11 @@
 
 #include "core/mesh_sequence.h"
 #include "core/trajectory.h"
-#include "../reliability/cli_harness.h"
+#include "../support/cli_test.h"
 
 namespace kf {
 namespace {
-namespace fs = std::filesystem;
-using reliability::read_text;
-using reliability::run_keyframe;
-using reliability::TempDirTest;
-using Json = nlohmann::json;
+using namespace cli_test;
 
 const fs::path kModels = "/usr/share/assimp/models";  // Debian's assimp-testmodels (scripts/setup)
 

@@ -12,15 +12,11 @@
 
 #include "core/mesh_sequence.h"
 #include "core/trajectory.h"
-#include "../reliability/cli_harness.h"
+#include "../support/cli_test.h"
 
 namespace kf {
 namespace {
-namespace fs = std::filesystem;
-using reliability::read_text;
-using reliability::run_keyframe;
-using reliability::TempDirTest;
-using Json = nlohmann::json;
+using namespace cli_test;
 
 const fs::path kSource = KEYFRAME_SOURCE_DIR;
 const fs::path kWuson = "/usr/share/assimp/models/X/Testwuson.X";  // Debian's assimp-testmodels (scripts/setup)

@@ -1,8 +1,5 @@
 // Interrupting an optimisation with SIGINT saves the best controls; --resume finishes the job.
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -11,11 +8,13 @@
 
 #include "app/optimize_job.h"
 #include "core/error.h"
+#include "../support/interrupted_run.h"
 #include "../reliability/cli_harness.h"
 
 namespace kf {
 namespace {
 namespace fs = std::filesystem;
+using test::run_keyframe_interrupted;
 
 const char* kScene = R"({
   "seed": 3,
@@ -28,35 +27,6 @@ const char* kScene = R"({
   "controls": {"kind": "per_step", "alpha": 0.001},
   "optimizer": {"max_evaluations": 400, "ftol_rel": 1e-12}
 })";
-
-// Runs keyframe with args in dir; when interrupt_after_lines > 0, sends SIGINT after that many lines.
-int run_keyframe(const fs::path& dir, const std::vector<std::string>& args, int interrupt_after_lines = 0) {
-  int fds[2];
-  EXPECT_EQ(pipe(fds), 0);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    dup2(fds[1], STDOUT_FILENO);
-    close(fds[0]);
-    if (chdir(dir.c_str()) != 0) _exit(120);
-    std::vector<char*> argv{const_cast<char*>(KEYFRAME_BINARY)};
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    execv(KEYFRAME_BINARY, argv.data());
-    _exit(127);
-  }
-  close(fds[1]);
-  FILE* out = fdopen(fds[0], "r");
-  char line[4096];
-  int lines = 0;
-  while (fgets(line, sizeof line, out)) {
-    if (std::string(line).find(" eval ") != std::string::npos || std::string(line).rfind("eval", 0) == 0) ++lines;
-    if (interrupt_after_lines > 0 && lines == interrupt_after_lines) kill(pid, SIGINT);
-  }
-  fclose(out);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
 
 double final_objective(const fs::path& run) {
   std::ifstream in(run / "report.json");
@@ -71,7 +41,7 @@ TEST(Resume, InterruptedThenResumedRunMatchesAnUninterruptedOne) {
 
   // At default settings the flock first converges short of its keyframes, then reaches them in stages with
   // their weights raised (opt/keyframe_weights.h); interrupts in those stages are covered below.
-  const int whole_code = run_keyframe(dir, {"optimize", "small.json", "--out", "whole"});
+  const int whole_code = run_keyframe_interrupted(dir, {"optimize", "small.json", "--out", "whole"});
   ASSERT_TRUE(whole_code == 0 || whole_code == kExitNotReached) << whole_code;
   const double whole = final_objective(dir / "whole");
   const int whole_evaluations = nlohmann::json::parse(std::ifstream(dir / "whole" / "report.json")).at("evaluations");
@@ -80,7 +50,7 @@ TEST(Resume, InterruptedThenResumedRunMatchesAnUninterruptedOne) {
   for (const int cut_after : {3, 40}) {
     SCOPED_TRACE("interrupted after " + std::to_string(cut_after) + " evaluations");
     const std::string cut = "cut" + std::to_string(cut_after);
-    EXPECT_EQ(run_keyframe(dir, {"optimize", "small.json", "--out", cut}, cut_after), kExitInterrupted);
+    EXPECT_EQ(run_keyframe_interrupted(dir, {"optimize", "small.json", "--out", cut}, cut_after), kExitInterrupted);
     std::ifstream report(dir / cut / "report.json");
     const auto j = nlohmann::json::parse(report);
     EXPECT_TRUE(j.at("interrupted").get<bool>());
@@ -91,7 +61,7 @@ TEST(Resume, InterruptedThenResumedRunMatchesAnUninterruptedOne) {
       EXPECT_GT(j.at("keyframe_weight_scales").at(0).get<double>(), 1.0) << "cut before the weights were raised";
     }
 
-    EXPECT_EQ(run_keyframe(dir, {"optimize", "--resume", cut}), whole_code);
+    EXPECT_EQ(run_keyframe_interrupted(dir, {"optimize", "--resume", cut}), whole_code);
     const double resumed = final_objective(dir / cut);
     EXPECT_NEAR(resumed, whole, 1e-3 * whole + 1e-9) << "uninterrupted " << whole << ", resumed " << resumed;
     EXPECT_EQ(reliability::read_text(dir / cut / "controls.bin"), reliability::read_text(dir / "whole" / "controls.bin"));

@@ -24,7 +24,7 @@ kf::Scene figure_scene(const std::string& name) {
 
 void optimise_scene(benchmark::State& state, const std::string& name, const std::string& preconditioner) {
   kf::Scene scene = figure_scene(name);
-  scene.cloth->cg_preconditioner = preconditioner;
+  scene.cloth->cg_preconditioner = kf::cg_preconditioner(preconditioner);
   for (auto _ : state) {
     auto sys = kf::make_system(scene);
     kf::Problem problem(scene, scene.time, *sys);
@@ -53,7 +53,8 @@ struct EndCost : kf::StateCost {
 // 1 incomplete Cholesky.
 void BM_RingTossPass(benchmark::State& state) {
   kf::Scene scene = figure_scene("ring-toss");
-  scene.cloth->cg_preconditioner = state.range(1) ? "incomplete_cholesky" : "block_jacobi";
+  scene.cloth->cg_preconditioner =
+      state.range(1) ? kf::CgPreconditioner::kIncompleteCholesky : kf::CgPreconditioner::kBlockJacobi;
   kf::ClothSystem sys(*scene.cloth, scene.time.h());
   kf::VecX x0, v0;
   sys.initial_state(x0, v0);

@@ -4,9 +4,6 @@
 // scenes (bench/bench_reachable.h): a sheet dropped onto a collider with keyframes at two frames, and a
 // curtain pinned along its top edge pulled aside.
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -19,42 +16,14 @@
 #include "app/optimize_job.h"
 #include "bench/bench_reachable.h"
 #include "core/error.h"
+#include "../support/interrupted_run.h"
 #include "../sim/character_test_util.h"
 
 namespace kf {
 namespace {
 namespace fs = std::filesystem;
+using test::run_keyframe_interrupted;
 using nlohmann::json;
-
-// Runs keyframe with args in dir; when interrupt_after > 0, sends SIGINT after that many evaluation lines.
-int run_keyframe(const fs::path& dir, const std::vector<std::string>& args, int interrupt_after = 0) {
-  int fds[2];
-  EXPECT_EQ(pipe(fds), 0);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    dup2(fds[1], STDOUT_FILENO);
-    close(fds[0]);
-    if (chdir(dir.c_str()) != 0) _exit(120);
-    std::vector<char*> argv{const_cast<char*>(KEYFRAME_BINARY)};
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    execv(KEYFRAME_BINARY, argv.data());
-    _exit(127);
-  }
-  close(fds[1]);
-  FILE* out = fdopen(fds[0], "r");
-  char line[4096];
-  int lines = 0;
-  while (fgets(line, sizeof line, out)) {
-    const std::string l(line);
-    if (l.find(" eval ") != std::string::npos || l.rfind("eval", 0) == 0) ++lines;
-    if (interrupt_after > 0 && lines == interrupt_after) kill(pid, SIGINT);
-  }
-  fclose(out);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
 
 // The run's worst keyframe miss (in tolerances) and its evaluations.
 std::pair<double, int> worst_miss(const fs::path& run) {
@@ -76,9 +45,9 @@ void expect_budget_run_ends_at_least_as_close(const std::string& kind, int index
   std::ofstream(dir.path() / "budget.json") << r.scene.dump(1);
   r.scene["optimizer"]["max_evaluations"] = 300;
   std::ofstream(dir.path() / "full.json") << r.scene.dump(1);
-  const int budget_code = run_keyframe(dir.path(), {"optimize", "budget.json", "--out", "budget"});
+  const int budget_code = run_keyframe_interrupted(dir.path(), {"optimize", "budget.json", "--out", "budget"});
   EXPECT_TRUE(budget_code == 0 || budget_code == kExitNotReached) << budget_code;
-  const int cut_code = run_keyframe(dir.path(), {"optimize", "full.json", "--out", "cut"}, kBudget);
+  const int cut_code = run_keyframe_interrupted(dir.path(), {"optimize", "full.json", "--out", "cut"}, kBudget);
   EXPECT_TRUE(cut_code == 0 || cut_code == kExitNotReached || cut_code == kExitInterrupted) << cut_code;
   const auto [budget_miss, budget_evaluations] = worst_miss(dir.path() / "budget");
   const auto [cut_miss, cut_evaluations] = worst_miss(dir.path() / "cut");

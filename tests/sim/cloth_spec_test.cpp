@@ -68,7 +68,7 @@ TEST(ClothSpec, CollidersAndErrorsNameTheirPlace) {
   EXPECT_EQ(std::get<TorusShape>(s.cloth->colliders[1].shape).axis, Vec3(0, 0, 1));
   EXPECT_STREQ(type_name(s.cloth->colliders[0]), "ground");
   EXPECT_EQ(make_system(s)->describe(), "cloth: 16x16 particles, 1378 springs, 0 pinned, 2 colliders, PCG (incomplete_cholesky, tolerance 1e-08), exact adjoint");
-  EXPECT_EQ(scene_with(R"({"cg_preconditioner": "block_jacobi"})").cloth->cg_preconditioner, "block_jacobi");
+  EXPECT_EQ(scene_with(R"({"cg_preconditioner": "block_jacobi"})").cloth->cg_preconditioner, CgPreconditioner::kBlockJacobi);
   EXPECT_NE(error_of(R"({"cg_preconditioner": "ilu"})").find("/cloth/cg_preconditioner: expected one of"),
             std::string::npos);
   EXPECT_NE(error_of(R"({"colliders": [{"type": "ground", "radius": 1}]})").find("/cloth/colliders/0/radius: unknown key"),

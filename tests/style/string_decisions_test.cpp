@@ -1,9 +1,11 @@
 // Decisions outside src/scene/ read types, not text: no file under src/ but the scene layer compares a
-// control kind's name, an optimiser's status text, a strategy's (or split schedule's) name or a keyframe
-// judgement's text. The names are read once in src/scene/ into enums (ControlKind, StagingStrategy,
-// SplitSchedule), the optimiser gives a StopReason beside its status text, and a keyframe's judgement says
-// what its error is (KeyframeJudgement::from_target). A line-based scan: each pattern below is one way such a
-// comparison is written.
+// control kind's name, an optimiser's status text, a strategy's (or split schedule's) name, a solver choice
+// (the cloth adjoint, the CG preconditioner), the effort term's name or a keyframe judgement's text. The names
+// are read once in src/scene/ into enums (ControlKind, StagingStrategy, SplitSchedule, AdjointKind,
+// CgPreconditioner), the optimiser gives a StopReason beside its status text, the effort is told by its place
+// in the breakdown (opt/term_breakdown.h), and a keyframe's judgement says what its error is
+// (KeyframeJudgement::from_target). A line-based scan: each pattern below is one way such a comparison is
+// written.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -21,15 +23,18 @@ namespace fs = std::filesystem;
 
 const char* const kControlKinds =
     "per_step|per_frame|initial_velocity|initial_rigid_velocity|initial_lattice_velocity|per_frame_lattice";
+// optimizer.adjoint and cloth.cg_preconditioner (scene/solver_choices.h; "auto" is left out: the benchmarks'
+// own --solver tokens use it), and the effort term's name in Problem::breakdown().
+const char* const kChoiceNames = "exact|swap|incomplete_cholesky|multigrid|block_jacobi|effort";
 const char* const kStatusWords =
     "converged|stopped|interrupted|evaluation limit|time limit|limit reached|keyframes reached|line search|"
     "no optimisation";
 
 const std::vector<std::regex>& patterns() {
   static const std::vector<std::regex> p = [] {
-    const std::string kinds = kControlKinds, statuses = kStatusWords;
+    const std::string kinds = std::string(kControlKinds) + "|" + kChoiceNames, statuses = kStatusWords;
     return std::vector<std::regex>{
-        // a == "per_frame", a != std::string("initial_velocity")
+        // a == "per_frame", a != std::string("initial_velocity"), name == "multigrid", name != "effort"
         std::regex("(==|!=)\\s*(std::string\\()?\"(" + kinds + ")\""),
         std::regex("\"(" + kinds + ")\"\\s*(==|!=)"),
         // s.rfind("initial", 0), status.find("limit reached"), s.compare("converged"), s.starts_with("per_")
@@ -82,14 +87,26 @@ TEST(StringDecisions, ScanFindsEachWayOfComparingByName) {
       R"(if (o.strategy == "single" || !scene.cloth) return plan;)",
       R"(job.hold_splits = scene.cloth && scene.optimizer.split_schedule == "held";)",
       R"(if (worst.tolerance.find("inside") != std::string::npos))",
+      // the solver choices and the effort term, as the cloth system, the strategy and the report decided
+      R"(if (name == "multigrid" || (name == "auto" && particles >= kMultigridFrom)) return Preconditioner::kMultigrid;)",
+      R"(if (name == "block_jacobi") return Preconditioner::kBlockJacobi;)",
+      R"(if (name == "exact") return AdjointKind::kExact;)",
+      R"(if (name == "swap") return AdjointKind::kSwap;)",
+      R"(if (terms.empty() || terms.back().first != "effort") return INFINITY;)",
+      R"(if (name != "effort") sum += value;)",
+      R"(if (name == "effort") effort_end = value;)",
   };
   for (const std::string& line : bad) EXPECT_EQ(string_decisions(line).size(), 1u) << line;
   const std::vector<std::string> good = {
       R"(if (res.reason != StopReason::kLineSearchStalled || left < 3) break;)",
       R"(if (o.strategy == StagingStrategy::kSingle) return plan;)",
       R"(os << "status " << r.status;  // "converged" == "converged")",
-      R"(if (name == "effort") effort_end = value;)",
       R"(if (!worst.from_target))",
+      R"(sys->set_adjoint(scene.optimizer.adjoint);)",
+      R"(if (!last_effort(problem)) return INFINITY;)",
+      R"(os << adjoint_name(adjoint_) << " adjoint";)",
+      R"(case Preconditioner::kBlockJacobi: return "block_jacobi";)",
+      R"(breakdown_.emplace_back("effort", e);)",
   };
   for (const std::string& line : good) EXPECT_TRUE(string_decisions(line).empty()) << line;
 }

@@ -238,7 +238,7 @@ std::vector<std::pair<std::string, double>> CapeSystem::run_stats() const {
 std::unique_ptr<System> make_cape_system(const Scene& scene, double h) {
   const int steps = int(std::llround(scene.time.duration() / h));
   auto sys = std::make_unique<CapeSystem>(*scene.cloth, *scene.character, scene.time.fps, steps, h);
-  sys->set_adjoint(adjoint_kind(scene.optimizer.adjoint));
+  sys->set_adjoint(scene.optimizer.adjoint);
   return sys;
 }
 

@@ -24,10 +24,14 @@ namespace {
 // (tests/results/bench/solver.csv).
 constexpr int kMultigridFrom = 15000;
 
-Preconditioner preconditioner_kind(const std::string& name, int particles) {
-  if (name == "multigrid" || (name == "auto" && particles >= kMultigridFrom)) return Preconditioner::kMultigrid;
-  if (name == "block_jacobi") return Preconditioner::kBlockJacobi;
-  return Preconditioner::kIncompleteCholesky;
+Preconditioner preconditioner_kind(CgPreconditioner chosen, int particles) {
+  switch (chosen) {
+    case CgPreconditioner::kMultigrid: return Preconditioner::kMultigrid;
+    case CgPreconditioner::kBlockJacobi: return Preconditioner::kBlockJacobi;
+    case CgPreconditioner::kIncompleteCholesky: return Preconditioner::kIncompleteCholesky;
+    case CgPreconditioner::kAuto: break;
+  }
+  return particles >= kMultigridFrom ? Preconditioner::kMultigrid : Preconditioner::kIncompleteCholesky;
 }
 
 const char* preconditioner_name(Preconditioner p) {
@@ -38,15 +42,7 @@ const char* preconditioner_name(Preconditioner p) {
   }
   return "incomplete_cholesky";
 }
-}  // namespace
 
-AdjointKind adjoint_kind(const std::string& name) {
-  if (name == "exact") return AdjointKind::kExact;
-  if (name == "swap") return AdjointKind::kSwap;
-  throw std::invalid_argument("unknown adjoint \"" + name + "\" (expected exact or swap)");
-}
-
-namespace {
 // The grid's positions at rest (3p, metres).
 VecX rest_positions(const ClothSpec& spec) {
   if (spec.mesh) return mesh_rest_positions(spec);
@@ -361,7 +357,7 @@ std::string ClothSystem::describe() const {
   tolerance << spec_.cg_tolerance;
   os << "cloth: " << (spec_.mesh ? std::to_string(p_) + " mesh" : std::to_string(spec_.nx) + "x" + std::to_string(spec_.ny)) << " particles, " << assembly_.springs().list.size() << " springs, "
      << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, "
-     << (direct_solve_ ? std::string("sparse ") + FilteredDirect::backend() : std::string("PCG (") + preconditioner_name(spec_.mesh && !spec_.block_jacobi() ? Preconditioner::kIncompleteCholesky : preconditioner_kind(spec_.cg_preconditioner, p_)) + ", tolerance " + tolerance.str() + ")") << ", " << (adjoint_ == AdjointKind::kExact ? "exact" : "swap") << " adjoint";
+     << (direct_solve_ ? std::string("sparse ") + FilteredDirect::backend() : std::string("PCG (") + preconditioner_name(spec_.mesh && !spec_.block_jacobi() ? Preconditioner::kIncompleteCholesky : preconditioner_kind(spec_.cg_preconditioner, p_)) + ", tolerance " + tolerance.str() + ")") << ", " << adjoint_name(adjoint_) << " adjoint";
   if (spec_.theta != 1) os << ", theta " << spec_.theta << " step";
   return os.str();
 }
@@ -376,7 +372,7 @@ std::unique_ptr<System> make_cloth_system(const Scene& scene, double h) {
     extra.push_back(std::move(self));
   }
   auto sys = std::make_unique<ClothSystem>(c, h, nullptr, std::move(extra));
-  sys->set_adjoint(adjoint_kind(scene.optimizer.adjoint));
+  sys->set_adjoint(scene.optimizer.adjoint);
   return sys;
 }
 

@@ -49,10 +49,6 @@
 
 namespace kf {
 
-enum class AdjointKind { kExact, kSwap };
-// "exact" | "swap" (scene key optimizer.adjoint, --adjoint); throws std::invalid_argument on others.
-AdjointKind adjoint_kind(const std::string& name);
-
 // What a cloth step records for its adjoint: its accepted substeps in order, each with its depth (length
 // h / 2^depth), start state (the step's own for the first one) and velocity change (3p, pins included).
 struct ClothRecord final : StepRecord {
