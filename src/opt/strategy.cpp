@@ -7,10 +7,13 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "opt/friction_continuation.h"
 #include "opt/keyframe_weights.h"
 #include "opt/restarts.h"
 #include "opt/term_breakdown.h"
 #include "opt/throw_fit.h"
+#include "opt/uncontrolled_floor.h"
+#include "sim/make_system.h"
 
 namespace kf {
 
@@ -31,6 +34,8 @@ struct Run {
   TimeSpec z_time;                    // the time discretisation the controls in r.z were made for
   std::vector<double> weight_scales;  // the keyframe weights' scales every new stage's problem gets
   std::vector<int> judged_until;      // per stage, the frame its keyframes count up to (opt/windows.h)
+  std::vector<double> friction_scales;  // per stage, on the scene's friction (StagePlan::friction_scales)
+  std::vector<VecX> stage_ends;       // each stage's best controls as the scene's own (opt/uncontrolled_floor.h)
   StrategyResult r;
 };
 
@@ -62,6 +67,18 @@ VecX forces_as_blocks(const Problem& prev, const VecX& z, const Controls& next) 
   VecX out(size);
   for (size_t b = 0; b < blocks.size(); ++b) out.segment(long(b) * blocks[b].size(), blocks[b].size()) = blocks[b];
   return out;
+}
+
+// z of the run's current problem as the scene's own controls (its held forces included); empty when they cannot
+// be written so (initial velocities, another timing or step length).
+VecX as_scene_controls(const Run& run, const VecX& z) {
+  const StrategyResult& r = run.r;
+  const Problem& p = *r.problem;
+  if (!p.controls().forces() || r.time.substeps != run.scene.time.substeps) return {};
+  Problem scene_problem(run.scene, r.time, *r.sys);
+  const Controls& c = scene_problem.controls();
+  if (!c.forces() || c.timing() != p.controls().timing()) return {};
+  return c.remap_from(forces_as_blocks(p, z, c), r.time, c.first_frame());
 }
 
 // The keyframe weight scales of a stage judged on keyframes up to frame `until` (opt/windows.h): later ones 0.
@@ -251,15 +268,26 @@ int judged_until(const Run& run, size_t s) {
   return s < run.judged_until.size() ? run.judged_until[s] : kAllKeyframes;
 }
 
+double friction_scale(const Run& run, size_t s) {
+  return s < run.friction_scales.size() ? run.friction_scales[s] : 1.0;
+}
+
+// Stage s's system at step length h: the hooks' at the scene's friction, else the scene's with it eased.
+std::unique_ptr<System> stage_system(const Run& run, size_t s, double h) {
+  const double scale = friction_scale(run, s);
+  return scale == 1.0 ? run.hooks.make_system(h) : make_system(with_friction_scaled(run.scene, scale), h);
+}
+
 // Stage s of the plan: its system (the first is built already), problem and optimisation.
 void run_stage(Run& run, const std::vector<StageSpec>& stages, size_t s) {
   StrategyResult& r = run.r;
   r.time.substeps = stages[s].substeps;
-  if (s > 0) r.sys = run.hooks.make_system(r.time.h());
+  const bool friction_changed = s > 0 && friction_scale(run, s) != friction_scale(run, s - 1);
+  if (s > 0 || friction_scale(run, s) != 1.0) r.sys = stage_system(run, s, r.time.h());
   const bool from_controls_file = run.resuming && s == 0 && r.z.size() > 0;
   const std::string memory_line = set_up_stage(run, stages[s], judged_until(run, s));
   // A stage at the last one's steps goes on with its schedule: under another, its best point may lie far off.
-  if (r.hold_splits && r.schedule.steps() == r.time.steps()) r.sys->hold_step_schedule(r.schedule);
+  if (r.hold_splits && r.schedule.steps() == r.time.steps() && !friction_changed) r.sys->hold_step_schedule(r.schedule);
   else hold_schedule_at(r, r.z);
   Problem& problem = *r.problem;
   if (from_controls_file) check_resumed_controls(run, problem, r.z);
@@ -288,6 +316,7 @@ void run_stage(Run& run, const std::vector<StageSpec>& stages, size_t s) {
       minimize_with_restarts(problem, spec, run.scene.optimizer.restarts, r.z, hooks, run.stop, r.tape);
   run.log.stage_finished();
   record_stage(run, res);
+  run.stage_ends.push_back(as_scene_controls(run, res.z));
 }
 
 // Runs stages[first], stages[first + 1], ...: a stage that converged or stalled early leaves its unspent
@@ -308,6 +337,14 @@ void run_stages(Run& run, std::vector<StageSpec>& stages, size_t first) {
       }
       run.r.reason = StopReason::kConverged;  // of the run: its later keyframes are still to be met
       run.log.say("the keyframes up to frame " + std::to_string(until) + " are met: on to the next keyframe");
+    } else if (friction_scale(run, s) != 1.0 && run.r.reason == StopReason::kKeyframesReached) {
+      while (next < stages.size() && friction_scale(run, next) != 1.0) {
+        if (!run.fixed_budgets && next + 1 < stages.size())
+          stages[next + 1].max_evaluations += stages[next].max_evaluations;
+        ++next;
+      }
+      run.r.reason = StopReason::kConverged;  // at eased friction: the scene's is still to come
+      run.log.say("the keyframes are met with friction eased: on to the scene's friction");
     }
     if (next < stages.size() && !run.fixed_budgets)
       stages[next].max_evaluations += std::max(0, stages[s].max_evaluations - run.r.stages.back().evaluations);
@@ -419,6 +456,34 @@ void release_held_forces(Run& run) {
   r.problem = std::move(scene_problem);
 }
 
+// A result that leaves a keyframe farther off than no control does falls back to the best stage end, or to no
+// control, that does not (opt/uncontrolled_floor.h). Judged at the scene's weights in the scene's controls.
+void keep_no_worse_than_uncontrolled(Run& run) {
+  StrategyResult& r = run.r;
+  if (!run.hooks.keyframes_unmet || !r.problem || r.interrupted || r.stages.empty() || run.from_controls) return;
+  Problem& problem = *r.problem;
+  if (!problem.held_forces().empty() || problem.controls().kind() != run.scene.controls.kind ||
+      problem.controls().first_frame() != run.scene.controls.from_frame)
+    return;
+  std::vector<VecX> candidates{r.z};
+  for (const VecX& z : run.stage_ends)
+    if (z.size() == r.z.size()) candidates.push_back(z);
+  // The result under the schedule its stage held, the others under their own (a cloth step's split pattern).
+  const auto before = [&r](size_t c) {
+    if (!r.hold_splits) return;
+    if (c == 0) r.sys->hold_step_schedule(r.schedule);
+    else r.sys->release_step_schedule();
+  };
+  const FloorVerdict v = uncontrolled_floor(problem, candidates, run.hooks.keyframes_unmet, before);
+  if (!v.fell_back()) return;
+  run.log.say(v.why);
+  r.z = v.chosen < candidates.size() ? candidates[v.chosen] : problem.initial_guess();
+  if (r.hold_splits) {
+    r.schedule = r.sys->step_schedule();
+    r.sys->hold_step_schedule(r.schedule);
+  }
+}
+
 }  // namespace
 
 StrategyResult run_strategy(StrategySetup setup, const StrategyHooks& hooks, StrategyLog& log) {
@@ -429,6 +494,7 @@ StrategyResult run_strategy(StrategySetup setup, const StrategyHooks& hooks, Str
           log};
   std::vector<StageSpec> stages = setup.plan.stages;
   run.judged_until = setup.plan.judged_until;
+  if (!run.from_controls) run.friction_scales = setup.plan.friction_scales;
   for (const auto& st : stages) run.all_evaluations += std::uint64_t(std::max(st.max_evaluations, 1));
   run.z_time = setup.start.size() ? setup.start_time : scene.time;
   StrategyResult& r = run.r;
@@ -444,6 +510,7 @@ StrategyResult run_strategy(StrategySetup setup, const StrategyHooks& hooks, Str
   release_held_forces(run);
   r.weight_scales = run.weight_scales;
   if (r.problem) r.problem->set_weight_scales({});
+  keep_no_worse_than_uncontrolled(run);
   r.planned_stages = int(stages.size());
   return std::move(run.r);
 }

@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "opt/friction_continuation.h"
 #include "opt/throw_search.h"
 #include "sim/make_system.h"
 
@@ -20,6 +21,28 @@ int last_keyframe(const Scene& scene) {
 }
 
 }  // namespace
+
+// The eased windows get this share of the budget, the windows at the scene's friction the rest.
+constexpr double kEasedShare = 0.4;
+
+void ease_friction(const Scene& scene, double scale, StagePlan& plan) {
+  if (plan.stages.size() < 2 || !has_friction(scene) || scale >= 1) return;
+  const int budget = scene.optimizer.max_evaluations;
+  const int eased = int(budget * kEasedShare);
+  std::vector<int> eased_until, until;
+  std::vector<StageSpec> stages = window_stages(scene, eased, &eased_until);
+  const std::vector<StageSpec> full = window_stages(scene, budget - eased, &until);
+  plan.friction_scales.assign(stages.size(), scale);
+  plan.friction_scales.resize(stages.size() + full.size(), 1.0);
+  stages.insert(stages.end(), full.begin(), full.end());
+  eased_until.insert(eased_until.end(), until.begin(), until.end());
+  plan.stages = std::move(stages);
+  plan.judged_until = std::move(eased_until);
+  std::ostringstream os;
+  os << "; friction eased in: these stages first with friction scaled by " << scale << " (" << eased
+     << " evaluations), then again at the scene's friction";
+  plan.why += os.str();
+}
 
 std::vector<int> keyframe_frames(const Scene& scene) {
   std::vector<int> frames;
