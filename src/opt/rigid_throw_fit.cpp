@@ -8,72 +8,12 @@
 #include <stdexcept>
 
 #include "opt/keyframes/keyframe_common.h"
+#include "opt/keyframe_residuals.h"
 #include "opt/keyframes/keyframe_kind.h"
 
 namespace kf {
 
 namespace {
-
-// One keyframe the residuals hold: where the sheet's particles should be at a step.
-struct Placed {
-  int step = 0;
-  std::vector<int> ids;
-  std::vector<Vec3> targets;  // one per id, or one for all; with `centroid`, the centroid's
-  bool centroid = false;
-  double root_weight = 1;     // √(w · scale): ½‖r‖² is the term φ sums
-};
-
-std::vector<Placed> placed_keyframes(Problem& problem, const Scene& scene) {
-  std::vector<Placed> out;
-  const int particles = problem.system().particles();
-  const std::vector<double>& scales = problem.weight_scales();
-  for (size_t k = 0; k < scene.objectives.size(); ++k) {
-    const ObjectiveSpec& o = scene.objectives[k];
-    const double scale = k < scales.size() ? scales[k] : 1.0;
-    const KeyframePlacement place = keyframe_placement(o);
-    if (place.kind == KeyframePlacement::Kind::kNone || place.targets.empty() || !(o.weight * scale > 0)) continue;
-    Placed p;
-    p.step = o.frame * problem.time().substeps;
-    p.ids = keyframe_members(o, particles);
-    p.targets = place.targets;
-    p.centroid = place.kind == KeyframePlacement::Kind::kCentroid;
-    p.root_weight = std::sqrt(o.weight * scale);
-    if (!p.centroid && p.targets.size() != 1 && p.targets.size() != p.ids.size()) continue;
-    out.push_back(std::move(p));
-  }
-  return out;
-}
-
-int residual_count(const std::vector<Placed>& placed) {
-  int n = 0;
-  for (const Placed& p : placed) n += 3 * (p.centroid ? 1 : int(p.ids.size()));
-  return n;
-}
-
-// The weighted residuals of the rollout into r, and the worst keyframe's unweighted RMS distance.
-double residuals(const Rollout& rollout, const std::vector<Placed>& placed, VecX& r) {
-  int row = 0;
-  double worst = 0;
-  for (const Placed& p : placed) {
-    const VecX& x = rollout.x[size_t(p.step)];
-    if (p.centroid) {
-      const Vec3 d = mean_of(x, p.ids) - p.targets[0];
-      r.segment<3>(row) = p.root_weight * d;
-      row += 3;
-      worst = std::max(worst, d.norm());
-      continue;
-    }
-    double sum = 0;
-    for (size_t j = 0; j < p.ids.size(); ++j) {
-      const Vec3 d = x.segment<3>(3 * p.ids[j]) - p.targets[p.targets.size() == 1 ? 0 : j];
-      r.segment<3>(row) = p.root_weight * d;
-      row += 3;
-      sum += d.squaredNorm();
-    }
-    worst = std::max(worst, std::sqrt(sum / double(std::max<size_t>(1, p.ids.size()))));
-  }
-  return worst;
-}
 
 // The sheet's RMS radius about its centroid: ω times it is a rim speed, so (Δv, ω · radius) are alike.
 double sheet_radius(Problem& problem) {
@@ -160,7 +100,7 @@ class RigidFitter {
     problem_.evaluate(z, nullptr);
     ++simulated_;
     if (problem_.last_diverged()) return false;
-    worst = residuals(problem_.rollout(), placed_, r);
+    worst = keyframe_residuals(problem_.rollout(), placed_, true, r);
     return r.allFinite();
   }
 
@@ -191,7 +131,7 @@ class RigidFitter {
   }
 
   Problem& problem_;
-  std::vector<Placed> placed_;
+  std::vector<PlacedKeyframe> placed_;
   int budget_;
   const std::atomic<bool>* stop_;
   double radius_ = 1, tolerance_ = 0.01, reach_ = 0;

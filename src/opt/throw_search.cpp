@@ -5,6 +5,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "opt/keyframe_residuals.h"
+#include "opt/keyframes/keyframe_common.h"
+
 namespace kf {
 
 namespace {
@@ -23,10 +26,37 @@ double radical_inverse(int k, int b) {
 
 int automatic_throw_count(int particles, int steps) {
   const double per_throw = std::max(1.0, double(particles) * std::max(1, steps));
-  return int(std::clamp(4e6 / per_throw, 32.0, 512.0));
+  // A large sheet's evaluations are dear too: beyond kLarge particle-steps a flight, the search's share of
+  // the run falls as the square of the flight's cost.
+  constexpr double kLarge = 12000;
+  const double large = per_throw > kLarge ? (kLarge / per_throw) * (kLarge / per_throw) : 1.0;
+  return int(std::clamp(4e6 / per_throw * large, 32.0, 512.0));
 }
 
-ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted, const std::atomic<bool>* stop) {
+// Whether the problem's last flight puts every keyframe within half its tolerance (none placed, or one that
+// places no particles: never).
+class MeetsKeyframes {
+ public:
+  MeetsKeyframes(Problem& problem, const Scene* scene) {
+    if (!scene || !scene->cloth) return;
+    bool all = false;
+    placed_ = placed_keyframes(problem, *scene, &all);
+    if (!all) placed_.clear();
+    r_.resize(residual_count(placed_));
+    reach_ = 0.5 * cloth_tolerance(*scene);
+  }
+  bool operator()(const Problem& problem) {
+    return !placed_.empty() && !problem.last_diverged() && keyframe_residuals(problem.rollout(), placed_, false, r_) <= reach_;
+  }
+
+ private:
+  std::vector<PlacedKeyframe> placed_;
+  VecX r_;
+  double reach_ = 0;
+};
+
+ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted, const std::atomic<bool>* stop,
+                          const Scene* scene) {
   if (problem.controls().kind() != ControlKind::kInitialRigidVelocity)
     throw std::logic_error("search_throws: the problem's controls are not a rigid throw");
   VecX x0, v0;
@@ -42,6 +72,7 @@ ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted
   double r2 = 0;
   for (int i = 0; i < p; ++i) r2 += (x0.segment<3>(3 * i) - centre).squaredNorm();
   const double radius = std::sqrt(r2 / std::max(1, p));
+  MeetsKeyframes meets(problem, scene);
 
   ThrowSearch s;
   s.speed = std::max(1.0, 0.5 * mean_v.norm());
@@ -72,6 +103,10 @@ ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted
       if (!problem.last_diverged() && phi < s.phi) {
         s.phi = phi;
         s.z = z;
+        if (meets(problem)) {  // the rigid stage starts at the keyframes: no throw left to beat it
+          s.met = true;
+          return s;
+        }
       }
     }
   }
@@ -94,9 +129,9 @@ ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int coun
   // A throw the fit brought to the keyframes needs no search (the scene's throw is still flown, once).
   const int spent = fitted.simulated + rigid.simulated;
   const int searched = rigid.reached() ? 0 : std::max(0, std::min(count - rigid.simulated, budget - spent));
-  ThrowSearch s = search_throws(problem, searched, fitted, stop);
+  ThrowSearch s = search_throws(problem, searched, fitted, stop, &scene);
   s.simulated += rigid.simulated;
-  if (!rigid.reached() && s.z.size() == 6 && std::none_of(starts.begin(), starts.end(), [&](const VecX& a) { return a == s.z; })) {
+  if (!rigid.reached() && !s.met && s.z.size() == 6 && std::none_of(starts.begin(), starts.end(), [&](const VecX& a) { return a == s.z; })) {
     o.max_simulations = std::clamp(budget - s.simulated, 0, quarter);
     const RigidThrowFit more = fit_rigid_throw(problem, scene, {s.z}, o);
     s.simulated += more.simulated;

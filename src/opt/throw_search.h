@@ -22,19 +22,22 @@ struct ThrowSearch {
   std::vector<double> fitted;  // the objectives of the fitted throw and its corrections (opt/throw_fit.h)
   double speed = 0;        // the box's half-width in Δv (m/s)
   double spin = 0;         // and in ω (rad/s)
+  bool met = false;        // it ended early at a throw that meets every keyframe within half its tolerance
   std::optional<RigidThrowFit> rigid;  // Levenberg–Marquardt on (Δv, ω) after the search (search_and_fit_throws)
 };
 
 // How many throws the automatic search simulates for a sheet of `particles` over `steps` steps: about four
-// million particle-steps, between 32 and 512 throws.
+// million particle-steps, fewer for a flight of more than 12000 (times (12000 / its particle-steps)²), between
+// 32 and 512 throws.
 int automatic_throw_count(int particles, int steps);
 
 // `problem` must have initial_rigid_velocity controls. The box: Δv within ±max(1 m/s, half the scene's mean
 // initial speed) on each axis, ω within ± that over the sheet's RMS radius (rim speeds alike).
 // `fitted` (refine_fitted_throw's, already flown) competes with the others and counts among the simulated.
-// A set *stop ends the search after the throw being simulated, with the best so far.
+// A set *stop ends the search after the throw being simulated, with the best so far. With `scene`, the search
+// ends at a new best throw that puts every keyframe (each placing particles) within half its tolerance.
 ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted = {},
-                          const std::atomic<bool>* stop = nullptr);
+                          const std::atomic<bool>* stop = nullptr, const Scene* scene = nullptr);
 
 // What runs before a rigid first stage: Levenberg–Marquardt on the six rigid variables (opt/rigid_throw_fit.h)
 // from the scene's throw and the throw fitted to the keyframes; when that does not meet them, the search

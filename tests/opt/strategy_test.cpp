@@ -205,7 +205,8 @@ TEST(Strategy, InitialVelocitiesStartFromASearchedRigidThrowThenALattice) {
 TEST(Strategy, AutomaticThrowSearchScalesWithTheSimulationsCost) {
   EXPECT_EQ(automatic_throw_count(144, 45), 512);       // a 12 x 12 towel over 1.5 s: the cap
   EXPECT_EQ(automatic_throw_count(2500, 56), 32);       // a 50 x 50 sheet: the floor
-  EXPECT_EQ(automatic_throw_count(400, 40), 250);       // 4e6 particle-steps
+  EXPECT_EQ(automatic_throw_count(300, 40), 333);       // 4e6 particle-steps
+  EXPECT_EQ(automatic_throw_count(676, 30), 69);        // a 26 x 26 sheet: 197 times (12000 / 20280)²
 }
 
 // The search returns the best throw it simulated: no throw it tried, re-simulated, does better, and the

@@ -1,0 +1,54 @@
+#pragma once
+// Gauss–Newton onto the keyframes of a thrown sheet's per-particle initial velocities. A thrown sheet's keyframes are a few residuals (three numbers per placed
+// particle or centre of mass) against hundreds of initial velocities, and at the optimum of keyframes plus
+// effort the effort may hold a reachable keyframe just outside its tolerance, where L-BFGS on φ spends its
+// budget on the trade-off. Here the keyframes are what must hold: Levenberg–Marquardt on the residuals r
+// alone with the minimum-norm step dz = −Jᵀ(JJᵀ + μI)⁻¹ r (the smallest change of the controls that the
+// linearised flight says meets them), J from one adjoint pass per residual.
+#include <atomic>
+#include <string>
+
+#include "core/types.h"
+#include "opt/problem.h"
+#include "scene/scene.h"
+
+namespace kf {
+
+enum class ProjectionStop {
+  kReached,        // every placed keyframe within ProjectionOptions::reach_share of its tolerance
+  kStalled,        // the damping grew past any useful step, or a step changed the residuals by nothing
+  kBudget,         // the passes allowed were spent
+  kInterrupted,    // *stop was set
+  kNotApplicable,  // not per-particle initial velocities (3 a particle), or a keyframe with weight places no
+                   // particles (a velocity or a height), or none does
+  kDiverged,       // the start itself diverged
+};
+
+struct ProjectionOptions {
+  int max_passes = 200;      // forward simulations plus adjoint passes
+  double reach_share = 0.5;  // done when every keyframe is within this share of its tolerance
+  double max_step = 1.0;     // the largest change of one control variable in one step (the controls' units)
+  const std::atomic<bool>* stop = nullptr;
+};
+
+struct KeyframeProjection {
+  VecX z;                    // the point with the smallest residuals reached (the start when nothing helped)
+  double start_worst = 0;    // the worst keyframe's distance over its tolerance at the start
+  double worst = 0;          // and at z
+  int iterations = 0;        // Jacobians formed
+  int simulations = 0;       // forward simulations
+  int adjoint_passes = 0;    // one per residual per Jacobian
+  ProjectionStop stop = ProjectionStop::kNotApplicable;
+  bool reached() const { return stop == ProjectionStop::kReached; }
+  bool improved() const { return worst < start_worst; }
+};
+
+// From z (the problem's controls), at the problem's weight scales and the system's held step schedule. The
+// problem's last rollout is left at an arbitrary point.
+KeyframeProjection project_onto_keyframes(Problem& problem, const Scene& scene, const VecX& z,
+                                          const ProjectionOptions& options);
+
+// One line for the run's log.
+std::string describe(const KeyframeProjection& p);
+
+}  // namespace kf
