@@ -42,7 +42,7 @@ class Projector {
     jacobian_.resize(flight_.rows(), problem.size());
     VecX x0, v0;
     problem.system().initial_state(x0, v0);
-    kernel_ = smooth_kernel(x0);
+    kernel_ = o.smooth ? smooth_kernel(x0) : Eigen::MatrixXd::Identity(x0.size() / 3, x0.size() / 3);
   }
 
   void run(VecX z, KeyframeProjection& out) {
@@ -88,8 +88,10 @@ class Projector {
           cost = trial_cost;
           r = flight_.residuals();
           worst = flight_.worst();
-          out.z = z;
-          out.worst = worst / tolerance_;
+          if (worst / tolerance_ < out.worst) {  // the point with the nearest worst keyframe, not the lowest ½‖r‖²
+            out.z = z;
+            out.worst = worst / tolerance_;
+          }
           if (negligible && worst > reach) return finish(out, ProjectionStop::kStalled);
           break;
         }
@@ -155,11 +157,38 @@ KeyframeProjection project_onto_keyframes(Problem& problem, const Scene& scene, 
   std::vector<PlacedKeyframe> placed = placed_keyframes(problem, scene, &all_placed);
   const Controls& c = problem.controls();
   if (placed.empty() || !all_placed || !scene.cloth || c.kind() != ControlKind::kInitialVelocity ||
-      problem.size() != 3 * problem.system().particles())
+      problem.size() != 3 * problem.system().particles() || 2 * residual_count(placed) > options.max_passes)
     return out;
   Projector projector(problem, std::move(placed), cloth_tolerance(scene), options);
   projector.run(z, out);
   return out;
+}
+
+KeyframeProjection project_unmet_then_all(Problem& problem, const Scene& scene, const VecX& z,
+                                          const std::vector<bool>& unmet, const ProjectionOptions& options) {
+  const std::vector<double> scales = problem.weight_scales();
+  std::vector<double> pressed(scene.objectives.size(), 1.0);
+  for (size_t k = 0; k < pressed.size(); ++k) {
+    if (k < scales.size()) pressed[k] = scales[k];
+    if (k >= unmet.size() || !unmet[k]) pressed[k] = 0.0;
+  }
+  ProjectionOptions o = options;
+  o.max_passes = options.max_passes / 2;
+  problem.set_weight_scales(pressed);
+  KeyframeProjection first = project_onto_keyframes(problem, scene, z, o);
+  problem.set_weight_scales(scales);
+  if (first.stop == ProjectionStop::kNotApplicable || first.stop == ProjectionStop::kDiverged ||
+      first.stop == ProjectionStop::kInterrupted)
+    return first;
+  // The met keyframes are at most one tolerance off, so the unmet ones' worst at the start is every keyframe's.
+  o.max_passes = options.max_passes - first.simulations - first.adjoint_passes;
+  KeyframeProjection all = project_onto_keyframes(problem, scene, first.z, o);
+  all.start_worst = first.start_worst;
+  all.iterations += first.iterations;
+  all.simulations += first.simulations;
+  all.adjoint_passes += first.adjoint_passes;
+  if (all.stop == ProjectionStop::kNotApplicable || all.stop == ProjectionStop::kDiverged) all.z = z, all.worst = all.start_worst;
+  return all;
 }
 
 namespace {

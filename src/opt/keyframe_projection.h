@@ -7,6 +7,7 @@
 // linearised flight says meets them), J from one adjoint pass per residual.
 #include <atomic>
 #include <string>
+#include <vector>
 
 #include "core/types.h"
 #include "opt/problem.h"
@@ -19,20 +20,24 @@ enum class ProjectionStop {
   kStalled,        // the damping grew past any useful step, or a step changed the residuals by nothing
   kBudget,         // the passes allowed were spent
   kInterrupted,    // *stop was set
-  kNotApplicable,  // not per-particle initial velocities (3 a particle), or a keyframe with weight places no
-                   // particles (a velocity or a height), or none does
+  kNotApplicable,  // not per-particle initial velocities (3 a particle), a keyframe with weight places no
+                   // particles (a velocity or a height) or none does, or a Jacobian (one adjoint pass per
+                   // residual) would take more than half the passes allowed (a keyframe on every particle)
   kDiverged,       // the start itself diverged
 };
 
 struct ProjectionOptions {
   int max_passes = 200;      // forward simulations plus adjoint passes
   double reach_share = 0.5;  // done when every keyframe is within this share of its tolerance
+  // Steps smallest in the smooth metric (affine plus a bend over the sheet; the default), else in plain
+  // per-particle velocities.
+  bool smooth = true;
   double max_step = 1.0;     // the largest change of one control variable in one step (the controls' units)
   const std::atomic<bool>* stop = nullptr;
 };
 
 struct KeyframeProjection {
-  VecX z;                    // the point with the smallest residuals reached (the start when nothing helped)
+  VecX z;                    // the point with the nearest worst keyframe reached (the start when nothing helped)
   double start_worst = 0;    // the worst keyframe's distance over its tolerance at the start
   double worst = 0;          // and at z
   int iterations = 0;        // Jacobians formed
@@ -47,6 +52,14 @@ struct KeyframeProjection {
 // problem's last rollout is left at an arbitrary point.
 KeyframeProjection project_onto_keyframes(Problem& problem, const Scene& scene, const VecX& z,
                                           const ProjectionOptions& options);
+
+// In turn: the keyframes `unmet` flags (per scene objective) alone, with half the passes, then every keyframe
+// from there with the rest. A keyframe in sliding contact is a rough function of the throw: pressed together
+// with one in free flight, its residuals spoil every step, where the one in flight is met alone in a Jacobian
+// or two. start_worst is the unmet keyframes' at z (the met ones are within their tolerance), worst every
+// keyframe's at the result.
+KeyframeProjection project_unmet_then_all(Problem& problem, const Scene& scene, const VecX& z,
+                                          const std::vector<bool>& unmet, const ProjectionOptions& options);
 
 // One line for the run's log.
 std::string describe(const KeyframeProjection& p);

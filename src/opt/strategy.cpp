@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "opt/friction_continuation.h"
+#include "opt/keyframe_projection.h"
 #include "opt/keyframe_weights.h"
 #include "opt/restarts.h"
 #include "opt/term_breakdown.h"
@@ -244,6 +245,30 @@ void search_throws_first(Run& run) {
   hold_schedule_at(r, r.z);
 }
 
+// Before a thrown sheet's per-particle stage, when the stages before left a keyframe unmet: Gauss–Newton onto
+// the unmet keyframes, then onto all (opt/keyframe_projection.h), with at most the stage's evaluations in
+// simulations and adjoint passes; the stage starts from its result when that brings the worst keyframe nearer.
+void project_before_stage(Run& run, const StageSpec& stage) {
+  StrategyResult& r = run.r;
+  Problem& problem = *r.problem;
+  if (!run.hooks.keyframes_unmet) return;
+  problem.evaluate(r.z, nullptr);
+  if (problem.last_diverged()) return;
+  const std::vector<bool> unmet = run.hooks.keyframes_unmet(problem);
+  if (!any_unmet(unmet)) return;
+  ProjectionOptions o;
+  o.max_passes = stage.max_evaluations;
+  o.stop = run.stop;
+  const auto t0 = std::chrono::steady_clock::now();
+  const KeyframeProjection p = project_unmet_then_all(problem, run.scene, r.z, unmet, o);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (p.stop == ProjectionStop::kNotApplicable) return;
+  std::ostringstream os;
+  os << describe(p) << " in " << std::fixed << std::setprecision(2) << seconds << " s";
+  run.log.say(os.str());
+  if (p.improved()) r.z = p.z;
+}
+
 // optimizer.stop_when_reached, asked of the problem's last rollout. A checkpointed rollout keeps too few
 // states to judge: the log says so once, and the run goes on by its other rules.
 // A stage judged on the keyframes up to frame `until` ends when those are met.
@@ -292,6 +317,9 @@ void run_stage(Run& run, const std::vector<StageSpec>& stages, size_t s) {
   Problem& problem = *r.problem;
   if (from_controls_file) check_resumed_controls(run, problem, r.z);
   if (s == 0 && run.plan.throw_search > 0 && !from_controls_file) search_throws_first(run);
+  if (s > 0 && run.plan.throw_search > 0 && problem.controls().kind() == ControlKind::kInitialVelocity &&
+      stages[s - 1].controls && !(run.stop && run.stop->load()))  // the first per-particle stage only
+    project_before_stage(run, stages[s]);
   if (run.stop && run.stop->load()) {  // before the stage's first evaluation: no stage to record
     r.interrupted = true;
     r.reason = StopReason::kInterrupted;
