@@ -45,6 +45,7 @@ RunFacts run_facts(const StrategyResult& run, const std::vector<HistoryRow>& his
   RunFacts f;
   f.status = run.status;
   f.budget = budget_spent(run.reason);
+  f.fallback = run.fallback;
   if (history.empty()) return f;
   f.objective_start = history.front().rec.phi;
   f.evaluations = int(history.size());
@@ -184,6 +185,7 @@ nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, bool re
   report["stage_results"] = nlohmann::json::array();
   for (const auto& st : job.stages) report["stage_results"].push_back(stage_json(st));
   if (!job.weight_scales.empty()) report["keyframe_weight_scales"] = job.weight_scales;
+  if (!job.fallback.empty()) report["fallback"] = job.fallback;
   if (job.throw_search) report["throw_search"] = throw_search_json(*job.throw_search, job.throw_seconds);
   for (const auto& [name, value] : job.sys->run_stats()) report["run_stats"][name] = value;
   if (scene.character) {

@@ -345,6 +345,7 @@ Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensit
   const std::string untouched = untouched_cause(keyframes);
   d.line = verdict_head(d, facts) + miss_text(*worst) + budget + "; " +
            (untouched.empty() ? likely_cause(s, facts, worst->miss_after) : untouched);
+  if (!facts.fallback.empty()) d.line += "; " + facts.fallback;
   return d;
 }
 

@@ -104,6 +104,7 @@ struct RunFacts {
   bool flock = false;                // a flock's run: its causes and changes name agents, not sheets
   int unstable_trials = 0;           // evaluations whose simulation the system refused as unstable
   int diverged_trials = 0;           // evaluations whose simulation diverged (the unstable ones included)
+  std::string fallback;              // why the run ended before its last stage's result (StrategyResult)
 };
 
 struct Diagnosis {

@@ -477,6 +477,7 @@ void keep_no_worse_than_uncontrolled(Run& run) {
   const FloorVerdict v = uncontrolled_floor(problem, candidates, run.hooks.keyframes_unmet, before);
   if (!v.fell_back()) return;
   run.log.say(v.why);
+  r.fallback = v.why;
   r.z = v.chosen < candidates.size() ? candidates[v.chosen] : problem.initial_guess();
   if (r.hold_splits) {
     r.schedule = r.sys->step_schedule();

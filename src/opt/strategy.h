@@ -98,6 +98,9 @@ struct StrategyResult {
   // left at the scene's weights, so what a report evaluates is the scene's objective.
   std::vector<double> weight_scales;
   int weight_rounds = 0;  // stages run with raised keyframe weights
+  // Non-empty when the result left a keyframe worse than uncontrolled and the run ended at an earlier stage's
+  // end or at no control instead (opt/uncontrolled_floor.h): why, for people.
+  std::string fallback;
   std::optional<ThrowSearch> throw_search;  // what the search over rigid throws found
   double throw_seconds = 0;
   // Sets the system's schedule as the result's optimisation saw it (after simulating anything else).

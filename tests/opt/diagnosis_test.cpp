@@ -260,5 +260,18 @@ TEST(Diagnosis, ABudgetStopStatesTheEvaluationsItExpectsToNeed) {
   EXPECT_NE(line.find("needs about 24 more"), std::string::npos) << line;
 }
 
+TEST(Diagnosis, ARunThatFellBackBelowItsResultSaysWhere) {
+  Sensitivity s;
+  s.growth = s.growth_beyond_free = 1.5;
+  RunFacts f = facts(10, 4, "converged");
+  const std::string plain = diagnose(one_keyframe(15, 4), s, f).line;
+  f.fallback = "the result leaves center_of_mass@13 farther off than uncontrolled: the run ends at no control";
+  const std::string line = diagnose(one_keyframe(15, 4), s, f).line;
+  EXPECT_EQ(plain.find("farther off than uncontrolled"), std::string::npos) << plain;
+  EXPECT_NE(line.find(f.fallback), std::string::npos) << line;
+  EXPECT_EQ(line.find(plain), 0u) << line;  // the rest of the line is unchanged
+  EXPECT_TRUE(diagnose(one_keyframe(15, 0.5), s, f).reached);  // a met keyframe stays met
+}
+
 }  // namespace
 }  // namespace kf

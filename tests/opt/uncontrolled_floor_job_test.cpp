@@ -4,6 +4,7 @@
 // 11.75 cm against 3.95 cm uncontrolled.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -29,9 +30,17 @@ void expect_no_keyframe_worse_than_uncontrolled(int index) {
   std::ifstream in(dir.path() / "run" / "report.json");
   const json report = json::parse(in);
   ASSERT_EQ(report.at("keyframe_errors").size(), std::size_t(r.keyframes));
-  for (const json& k : report.at("keyframe_errors"))
-    if (!k.at("met").get<bool>())
+  for (const json& k : report.at("keyframe_errors")) {
+    if (!k.at("met").get<bool>()) {
       EXPECT_LE(k.at("miss_after").get<double>(), k.at("miss_before").get<double>() * (1 + 1e-9)) << k.dump();
+    }
+  }
+  if (report.contains("fallback")) {  // a run that fell back says so in its diagnosis
+    const std::string why = report.at("fallback").get<std::string>();
+    EXPECT_NE(why.find("farther off than uncontrolled"), std::string::npos) << why;
+    EXPECT_NE(report.at("diagnosis").at("diagnosis").get<std::string>().find(why), std::string::npos);
+  }
+  std::printf("drop-collider-%d: %s\n", index, report.contains("fallback") ? "fell back" : "kept its result");
 }
 
 TEST(UncontrolledFloorJob, ReducedFrictionDropsEndNoKeyframeWorseThanUncontrolled) {
