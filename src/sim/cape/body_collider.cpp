@@ -69,9 +69,11 @@ bool BodyCollider::friction(int, const Vec3& x, const Vec3& v, bool exact, Conta
   // Limit mu g(thickness - phi), dL/dx = -mu g' n; slip u = v - vb(x).
   const FrictionForce fr = friction_force(friction_.mu * g, n, v - vb, friction_.eps);
   out.f = fr.f;
-  out.dfdv = fr.dfdu;
+  out.dfdv = fr.damping;
   out.dfdx.setZero();
+  out.dfdv_rest.setZero();
   if (exact) {
+    out.dfdv_rest = fr.dfdu - fr.damping;
     out.dfdx = fr.dfdL * (-friction_.mu * dg * n).transpose() - fr.dfdu * dvb;
     if (curvature_) out.dfdx += fr.dfdn * dn;
   }

@@ -117,12 +117,13 @@ bool SelfCollider::friction(int, const Vec3& x, const Vec3& v, bool exact, Conta
   if (!friction_.on()) return false;
   int found = 0;
   Vec3 f = Vec3::Zero();
-  Mat3 K = Mat3::Zero(), D = Mat3::Zero();
+  Mat3 K = Mat3::Zero(), D = Mat3::Zero(), rest = Mat3::Zero();
   for_each_near(x, [&](int j, const Vec3& d) {
     Mat3 Kf;
     const FrictionForce fr = pair_friction(d, v - seg(v_, j), Kf);
     f += fr.f;
-    D += fr.dfdu;
+    D += fr.damping;
+    rest += fr.dfdu - fr.damping;
     K += Kf;
     ++found;
   });
@@ -130,6 +131,7 @@ bool SelfCollider::friction(int, const Vec3& x, const Vec3& v, bool exact, Conta
   out.f = f;
   out.dfdv = D;
   out.dfdx = exact ? K : Mat3::Zero();
+  out.dfdv_rest = exact ? rest : Mat3::Zero();
   return true;
 }
 

@@ -8,8 +8,9 @@
 // add_cross_transpose puts them into the adjoints' Kx^T w so xhat uses the exact Jacobian.
 //
 // Friction (Collider::set_friction) acts on each pair against the relative velocity u = v_i - v_j, with limit
-// mu g(thickness - r) and normal n = d / r. Its velocity coupling is the same gather: d f_i / d v_i in the
-// implicit matrix, the cross block d f_i / d v_j = -(that) through add_friction_coupled.
+// mu g(thickness - r) and normal n = d / r. Its velocity coupling is the same gather: the damping block
+// (friction.h) in the implicit matrix, the rest of d f_i / d v_i in the exact Jacobian, and the cross block
+// d f_i / d v_j = -d f_i / d v_i through add_friction_coupled.
 #include <atomic>
 #include <cstdint>
 #include <utility>
@@ -55,7 +56,7 @@ class SelfCollider final : public Collider {
   Vec3 pair_stiffness_derivative(const Vec3& d, const Vec3& w, const Vec3& c) const;
   // Friction of one pair on particle i (offset d, slip u = v_i - v_j) and its exact d f_i / d x_i.
   FrictionForce pair_friction(const Vec3& d, const Vec3& u, Mat3& dfdx) const;
-  // d/dd and d/du of [a . D(d, u) b], D = pair_friction(d, u).dfdu.
+  // d/dd and d/du of [a . D(d, u) b], D = pair_friction(d, u).damping (the block the implicit matrix holds).
   void pair_damping_derivative(const Vec3& d, const Vec3& u, const Vec3& a, const Vec3& b, Vec3& ddd,
                                Vec3& ddu) const;
 

@@ -48,9 +48,13 @@ bool DistanceCollider::friction(int, const Vec3& x, const Vec3& v, bool exact, C
   // Limit L = mu g(thickness - phi): dL/dx = -mu g' n. The surface is still: the slip is v itself.
   const FrictionForce fr = friction_force(friction_.mu * g, n, v, friction_.eps);
   out.f = fr.f;
-  out.dfdv = fr.dfdu;
+  out.dfdv = fr.damping;
   out.dfdx.setZero();
-  if (exact) out.dfdx = fr.dfdL * (-friction_.mu * dg * n).transpose() + fr.dfdn * dn;
+  out.dfdv_rest.setZero();
+  if (exact) {
+    out.dfdx = fr.dfdL * (-friction_.mu * dg * n).transpose() + fr.dfdn * dn;
+    out.dfdv_rest = fr.dfdu - fr.damping;
+  }
   return true;
 }
 

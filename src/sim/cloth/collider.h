@@ -11,11 +11,11 @@
 // two vectors (definite_stiffness_derivative).
 //
 // Friction (FrictionParams, sim/cloth/friction.h; the cloth's FrictionTerm sums it) is the smoothed Coulomb
-// force of limit mu g against the velocity relative to the surface, apart from contact(). Its df/dv is a
-// damping block (symmetric, negative semi-definite, held by the implicit matrix); its df/dx (through g, n
-// and, on a moving surface, the surface's velocity at the closest point) is only in the exact Jacobian.
-// Since df/dv depends on x and v, the exact adjoint also needs d/dx and d/dv of w . D(x, v) c
-// (damping_derivative).
+// force of limit mu g against the velocity relative to the surface, apart from contact(). Its damping block
+// D (the drag coefficient at the step's start, friction.h: symmetric, negative semi-definite, held by the
+// implicit matrix) is not its df/dv; the rest of df/dv and its df/dx (through g, n and, on a moving surface,
+// the surface's velocity at the closest point) are only in the exact Jacobian. Since D depends on x and v,
+// the exact adjoint also needs d/dx and d/dv of w . D(x, v) c (damping_derivative).
 #include <memory>
 #include <vector>
 
@@ -29,7 +29,9 @@ namespace kf {
 struct ContactForce {
   Vec3 f = Vec3::Zero();           // N
   Mat3 dfdx = Mat3::Zero();        // N/m
-  Mat3 dfdv = Mat3::Zero();        // N s/m
+  Mat3 dfdv = Mat3::Zero();        // N s/m: the damping block the implicit matrix holds
+  // N s/m: the exact df/dv less dfdv, when `exact` (friction's lagged drag coefficient, friction.h); else 0.
+  Mat3 dfdv_rest = Mat3::Zero();
 };
 
 class Collider {
@@ -58,13 +60,14 @@ class Collider {
   virtual void add_cross_transpose(int /*n*/, const VecX& /*w*/, double /*scale*/, VecX& /*out*/) const {}
 
   // Friction of the particle at x moving with v at step n (FrictionParams; sim/cloth/friction.h): its force,
-  // its damping block dfdv (what the implicit matrix holds) and, when `exact`, its df/dx (else zero).
+  // its damping block dfdv (what the implicit matrix holds) and, when `exact`, its df/dx and dfdv_rest
+  // (else zero).
   // Returns false (and leaves `out` untouched) without friction or contact. A pair collider gathers the
   // particle's pairs here and puts the blocks coupling two particles in add_friction_coupled.
   virtual bool friction(int /*n*/, const Vec3& /*x*/, const Vec3& /*v*/, bool /*exact*/, ContactForce& /*out*/) const {
     return false;
   }
-  // d/dx and d/dv of [w . D(x, v) c], D the dfdv of friction() (both zero out of contact, without friction,
+  // d/dx and d/dv of [w . D(x, v) c], D the dfdv (damping block) of friction() (both zero out of contact, without friction,
   // and for pair colliders, which need both ends: add_friction_coupled carries theirs).
   virtual void damping_derivative(int /*n*/, const Vec3& /*x*/, const Vec3& /*v*/, const Vec3& /*w*/,
                                   const Vec3& /*c*/, Vec3& ddx, Vec3& ddv) const {

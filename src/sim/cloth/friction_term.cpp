@@ -16,6 +16,7 @@ void FrictionTerm::add_adjoint(const ClothAdjoint& a, int i, AdjointRow& row) co
   for (const auto& col : *colliders_) {
     if (!col->friction(a.n, seg(a.x, i), seg(a.v, i), /*exact=*/true, c)) continue;
     row.x += c.dfdx.transpose() * seg(a.w, i);
+    row.v += c.dfdv_rest.transpose() * seg(a.w, i);
     if (!a.exact) continue;
     Vec3 ddx, ddv;
     col->damping_derivative(a.n, seg(a.x, i), seg(a.v, i), seg(a.w, i), seg(a.dv, i), ddx, ddv);
