@@ -29,14 +29,23 @@ namespace {
 // Empty when `path` is a regular file under the cap; otherwise what is wrong with it.
 std::string file_problem(const char* path) {
   struct stat st {};
-  if (::stat(path, &st) != 0) return "not found";
+  if (::stat(path, &st) != 0) return errno == ENOENT || errno == ENOTDIR ? "not found" : std::strerror(errno);
   if (!S_ISREG(st.st_mode)) return "not a regular file";
   if (std::uintmax_t(st.st_size) > kMaxMeshFileBytes) return "larger than the 1 GiB a mesh file may be";
   return "";
 }
 
+// Whether nothing is at `path` (no entry, or a path through a non-directory), as opposed to something
+// that is there but refused.
+bool absent(const char* path) {
+  struct stat st {};
+  return ::stat(path, &st) != 0 && (errno == ENOENT || errno == ENOTDIR);
+}
+
 // assimp's file access, refusing anything but regular files under the cap (a FIFO would block the read,
-// /dev/zero would never end) and any writing; remembers the first file it refused.
+// /dev/zero would never end) and any writing; remembers the first file it refused. A file that does not
+// exist reads as absent, as with assimp's own IOSystem: importers probe for optional companions (an SMD's
+// <name>_animation.txt) and go on without them; one they need fails in assimp with its own message.
 class RegularFilesOnly : public Assimp::DefaultIOSystem {
  public:
   bool Exists(const char* file) const override {
@@ -44,7 +53,9 @@ class RegularFilesOnly : public Assimp::DefaultIOSystem {
     return ::stat(file, &st) == 0;  // not by opening it, which blocks on a FIFO
   }
   Assimp::IOStream* Open(const char* file, const char* mode) override {
-    std::string problem = std::strpbrk(mode, "wa+") ? "opened for writing" : file_problem(file);
+    const bool writing = std::strpbrk(mode, "wa+") != nullptr;
+    if (!writing && absent(file)) return nullptr;
+    std::string problem = writing ? "opened for writing" : file_problem(file);
     if (problem.empty()) return Assimp::DefaultIOSystem::Open(file, mode);
     if (refused.empty()) refused = "'" + printable(file) + "' (a file it reads): " + problem;
     return nullptr;

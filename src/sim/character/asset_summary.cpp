@@ -7,6 +7,7 @@
 #include <assimp/Importer.hpp>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <set>
 #include <sstream>
 
@@ -53,9 +54,13 @@ std::string fmt(double v) {
 
 std::string fmt(const Vec3& v) { return "(" + fmt(v.x()) + ", " + fmt(v.y()) + ", " + fmt(v.z()) + ")"; }
 
-// Nodes, parents first, with their bind-pose positions; `by_name` gets each node's index.
-void read_nodes(const aiScene& scene, AssetSummary& s, std::map<std::string, int>& by_name) {
+// Nodes, parents first, with their bind-pose positions; `by_name` gets each node's index, `placed` each
+// mesh's transform to the file's frame (its node's, through its parents; identity for a mesh no node holds).
+void read_nodes(const aiScene& scene, AssetSummary& s, std::map<std::string, int>& by_name,
+                std::vector<Affine>& placed) {
   std::vector<Affine> world;
+  placed.assign(scene.mNumMeshes, Affine::Identity());
+  std::vector<bool> seen(scene.mNumMeshes, false);
   std::vector<std::pair<const aiNode*, int>> stack = {{scene.mRootNode, -1}};
   while (!stack.empty()) {
     const auto [n, parent] = stack.back();
@@ -67,14 +72,18 @@ void read_nodes(const aiScene& scene, AssetSummary& s, std::map<std::string, int
     node.meshes = int(n->mNumMeshes);
     world.push_back(parent < 0 ? to_affine(n->mTransformation) : world[size_t(parent)] * to_affine(n->mTransformation));
     node.position = world.back().translation();
+    for (unsigned i = 0; i < n->mNumMeshes; ++i)
+      if (n->mMeshes[i] < scene.mNumMeshes && !seen[n->mMeshes[i]]) seen[n->mMeshes[i]] = true, placed[n->mMeshes[i]] = world.back();
     by_name.emplace(node.name, int(s.nodes.size()));
     s.nodes.push_back(node);
     for (unsigned c = n->mNumChildren; c-- > 0;) stack.push_back({n->mChildren[c], int(s.nodes.size()) - 1});
   }
 }
 
-// Each mesh's counts and box, the whole file's box, and which nodes are bones (at their bind pose).
-void read_meshes(const aiScene& scene, AssetSummary& s, const std::map<std::string, int>& by_name) {
+// Each mesh's counts and box where its node places it (an FBX's unit scale sits in its node transforms),
+// the whole file's box, and which nodes are bones (at their bind pose).
+void read_meshes(const aiScene& scene, AssetSummary& s, const std::map<std::string, int>& by_name,
+                 const std::vector<Affine>& placed) {
   bool first = true;
   for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
     const aiMesh* mesh = scene.mMeshes[m];
@@ -84,7 +93,7 @@ void read_meshes(const aiScene& scene, AssetSummary& s, const std::map<std::stri
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) out.triangles += mesh->mFaces[f].mNumIndices == 3 ? 1 : 0;
     out.bones = int(mesh->mNumBones);
     for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
-      const Vec3 p(mesh->mVertices[v].x, mesh->mVertices[v].y, mesh->mVertices[v].z);
+      const Vec3 p = placed[m] * Vec3(mesh->mVertices[v].x, mesh->mVertices[v].y, mesh->mVertices[v].z);
       grow(out.lo, out.hi, p, v == 0);
       grow(s.lo, s.hi, p, first);
       first = false;
@@ -94,8 +103,8 @@ void read_meshes(const aiScene& scene, AssetSummary& s, const std::map<std::stri
       if (it == by_name.end()) continue;
       AssetNode& node = s.nodes[size_t(it->second)];
       node.bone = true;
-      // A bone's bind pose: the inverse of its offset (bone-from-mesh) matrix.
-      node.position = to_affine(mesh->mBones[b]->mOffsetMatrix).inverse().translation();
+      // A bone's bind pose: the inverse of its offset (bone-from-mesh) matrix, where the mesh is placed.
+      node.position = (placed[m] * to_affine(mesh->mBones[b]->mOffsetMatrix).inverse()).translation();
     }
     s.meshes.push_back(out);
   }
@@ -119,6 +128,41 @@ void read_animations(const aiScene& scene, AssetSummary& s, const std::map<std::
   }
 }
 
+// Bounds and bone positions as a scene's character poses the file at its bind pose (Character: the
+// animation's time 0, skinned), when it loads as one; a file that does not keeps its meshes where their
+// nodes place them.
+void place_as_posed(const std::filesystem::path& file, AssetSummary& s, const std::map<std::string, int>& by_name) {
+  std::unique_ptr<Character> c;
+  try {
+    c = std::make_unique<Character>(file);
+  } catch (const InputError&) {
+    return;
+  }
+  if (c->mesh_names().size() != s.meshes.size()) return;
+  const VecX& x = c->bind_vertices();
+  for (size_t m = 0; m < s.meshes.size(); ++m)
+    for (int v = c->mesh_vertex_begin()[m]; v < c->mesh_vertex_begin()[m + 1]; ++v) {
+      grow(s.meshes[m].lo, s.meshes[m].hi, seg(x, v), v == c->mesh_vertex_begin()[m]);
+      grow(s.lo, s.hi, seg(x, v), v == 0);
+    }
+  for (const CharacterBone& b : c->bones()) {
+    const auto it = by_name.find(c->nodes()[size_t(b.node)].name);
+    if (it != by_name.end() && s.nodes[size_t(it->second)].bone) s.nodes[size_t(it->second)].position = b.bind.translation();
+  }
+}
+
+// The height a scene gets from the file along each axis it may call up, in file units and, at the units the
+// file states, in metres: what character.scale and character.up_axis choose between.
+std::string height_text(const AssetSummary& s) {
+  const Vec3 size = s.hi - s.lo;
+  std::string out = "height: " + fmt(size.y()) + " along Y (up_axis \"y\"), " + fmt(size.z()) +
+                    " along Z (up_axis \"z\") file units";
+  if (s.unit_scale > 0)
+    out += "; at its stated units (scale " + fmt(s.unit_scale) + ") " + fmt(s.unit_scale * size.y()) + " m and " +
+           fmt(s.unit_scale * size.z()) + " m";
+  return out;
+}
+
 }  // namespace
 
 AssetSummary summarize_asset(const std::filesystem::path& file) {
@@ -134,9 +178,11 @@ AssetSummary summarize_asset(const std::filesystem::path& file) {
   s.file = name;
   read_metadata(*scene, s);
   std::map<std::string, int> by_name;
-  read_nodes(*scene, s, by_name);
-  read_meshes(*scene, s, by_name);
+  std::vector<Affine> placed;
+  read_nodes(*scene, s, by_name, placed);
+  read_meshes(*scene, s, by_name, placed);
   read_animations(*scene, s, by_name);
+  place_as_posed(file, s, by_name);
   return s;
 }
 
@@ -180,9 +226,11 @@ std::string asset_text(const AssetSummary& s) {
   std::ostringstream os;
   const int bones = int(std::count_if(s.nodes.begin(), s.nodes.end(), [](const AssetNode& n) { return n.bone; }));
   os << s.file << "\n";
-  os << "  bounds " << fmt(s.lo) << " to " << fmt(s.hi) << ", size " << fmt(s.hi - s.lo) << " (file units)\n";
+  os << "  bounds " << fmt(s.lo) << " to " << fmt(s.hi) << ", size " << fmt(s.hi - s.lo)
+     << " (file units, the bind pose as a scene poses it)\n";
   os << "  up axis: " << (s.up_axis.empty() ? "not stated (keyframe takes +Y)" : s.up_axis)
      << "; units: " << (s.unit_scale > 0 ? fmt(s.unit_scale) + " m each" : "not stated (keyframe takes metres)") << "\n";
+  os << "  " << height_text(s) << "\n";
   os << "meshes (" << s.meshes.size() << "; a character's anchors name one as \"mesh\"):\n";
   for (const AssetMesh& m : s.meshes)
     os << "  " << (m.name.empty() ? "(unnamed)" : m.name) << ": " << m.vertices << " vertices, " << m.triangles

@@ -18,7 +18,8 @@ struct AssetMesh {
   std::string name;
   int vertices = 0, triangles = 0;  // after joining identical vertices and triangulating
   int bones = 0;                    // bones that weight this mesh's vertices
-  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();  // bounding box of the bind pose, the file's frame and units
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();  // box of the bind pose as a character is posed (Character::
+                                              // bind_vertices), the file's frame and units
 };
 
 struct AssetNode {

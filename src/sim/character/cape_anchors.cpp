@@ -52,7 +52,7 @@ std::vector<int> nearest_bind_vertices(const Character& character, const std::ve
 
 Vec3 node_bind_position(const Character& character, int node) {
   for (const CharacterBone& b : character.bones())
-    if (b.node == node && !b.offset.matrix().isIdentity()) return b.offset.inverse().translation();
+    if (b.node == node) return b.bind.translation();
   Affine world = Affine::Identity();
   for (int n = node; n >= 0; n = character.nodes()[size_t(n)].parent) world = character.nodes()[size_t(n)].rest_local * world;
   return world.translation();

@@ -16,8 +16,8 @@ namespace kf {
 std::vector<int> nearest_bind_vertices(const Character& character, const std::vector<Vec3>& targets,
                                        const std::string& mesh = "", const std::string& where = "");
 
-// Bind-pose position of a node (file frame, before the placement): a bone's from its offset matrix, any
-// other node's from its rest transforms.
+// Bind-pose position of a node (file frame, before the placement): a bone's where the bind pose puts it
+// (Character::bind_vertices), any other node's from its rest transforms.
 Vec3 node_bind_position(const Character& character, int node);
 
 // The anchor points, file frame: anchors.points, or the bind-pose positions of anchors.nodes (throws

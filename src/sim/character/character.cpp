@@ -228,9 +228,9 @@ Character::Character(const std::filesystem::path& file, const CharacterOptions& 
   skin_.assign(bones_.size(), Eigen::Matrix<double, 3, 4>::Zero());
   scratch_a_.resize(raw_vertices_.size());
   scratch_b_.resize(raw_vertices_.size());
-  bind_vertices_.resize(raw_vertices_.size());
-  for (int v = 0; v < vertex_count(); ++v)
-    bind_vertices_.segment<3>(3 * v) = options_.placement * Vec3(raw_vertices_.segment<3>(3 * v));
+  pose(0.0, bind_vertices_);
+  const Affine file_from_world = options_.placement.inverse();
+  for (CharacterBone& b : bones_) b.bind = file_from_world * world_[size_t(b.node)];  // world_ at time 0
 }
 
 int Character::node_index(const std::string& name) const {

@@ -55,6 +55,7 @@ struct CharacterBone {
   std::string name;
   int node = -1;
   Affine offset = Affine::Identity();
+  Affine bind = Affine::Identity();  // its node in the bind pose (below), the file's frame
 };
 
 class Character {
@@ -70,7 +71,9 @@ class Character {
   const std::string& file() const { return file_; }  // as given to the constructor, for messages
   int vertex_count() const { return static_cast<int>(bind_vertices_.size() / 3); }
   int triangle_count() const { return static_cast<int>(triangles_.rows()); }
-  // Bind-pose vertices: 3n entries, metres, file frame with `placement` applied.
+  // Bind-pose vertices: 3n entries, file frame with `placement` applied. The bind pose is the pose at the
+  // animation's time 0 (a static file's: its node transforms), posed as any time is: an FBX's unit scale
+  // and axis turn sit in its node transforms, which its raw mesh vertices leave out.
   const VecX& bind_vertices() const { return bind_vertices_; }
   const TriangleIndices& triangles() const { return triangles_; }
   // First vertex / triangle of each joined mesh, plus a final entry equal to the total count.
