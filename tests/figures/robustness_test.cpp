@@ -102,6 +102,20 @@ TEST(Robustness, TableclothOnATableHangsACornerAtItsMark) {
   expect_every_keyframe_met(optimise(suite_scene("tablecloth-table"), dir.path()));
 }
 
+// An 11 x 11 napkin on the ground with self contact, its top edge keyframed onto its bottom edge 4 cm up and
+// its bottom edge kept in place: folded in half at defaults (tests/results/shots/README.md), its layers apart.
+TEST(Robustness, NapkinFoldsInHalfAtItsMark) {
+  test::TempDir dir;
+  const json report = optimise(suite_scene("napkin-fold"), dir.path());
+  const json& keyframes = report.at("keyframe_errors");  // the top edge, then the bottom edge (met unaided)
+  EXPECT_EQ(report.at("diagnosis").at("outcome"), "reached") << report.at("diagnosis").dump();
+  ASSERT_EQ(keyframes.size(), 2u);
+  EXPECT_GT(keyframes[0].at("miss_before").get<double>(), 1.0) << keyframes[0].dump();
+  for (const json& k : keyframes) EXPECT_TRUE(k.at("met").get<bool>()) << k.dump();
+  for (const json& m : report.at("measures"))
+    if (m.at("type") == "ground") EXPECT_GT(m.at("lowest_at_end").get<double>(), 0.0) << m.dump();
+}
+
 // A cape hung by anchors on a Z-up Blender figure in its own units (BLEND/HUMAN.blend, scale 0.17, up_axis
 // "z"), its hem's centre lifted and swung back from where it hangs unaided ("from": "uncontrolled"). Through
 // the binary: building this figure's ray-tracing hierarchy in the library trips the tests' floating-point traps.
