@@ -13,6 +13,7 @@
 #include "opt/problem.h"
 #include "scene/scene.h"
 #include "sim/make_system.h"
+#include "gradient_test_helpers.h"
 
 namespace kf {
 namespace {
@@ -62,10 +63,7 @@ TEST(ClothFrictionLine, NoJumpAlongALineAtZeroAndPerturbedControls) {
   auto sys = make_system(scene);
   Problem problem(scene, scene.time, *sys);
   for (double perturb : {0.0, 0.3}) {
-    std::mt19937_64 rng(5);
-    std::normal_distribution<double> normal(0.0, perturb * problem.control_scale());
-    VecX z = problem.initial_guess();
-    for (int i = 0; i < z.size(); ++i) z[i] += normal(rng);
+    const VecX z = test::perturbed_controls(problem, perturb * problem.control_scale(), 5);
     const Line l = line_through(problem, *sys, z);
     std::printf("perturb %g: phi %.10g, moves %.2e %.2e at 1e-9, %.2e %.2e at 1e-7 (of itself)\n", perturb, l.phi,
                 (l.plus9 - l.phi) / l.phi, (l.minus9 - l.phi) / l.phi, (l.plus7 - l.phi) / l.phi,
@@ -88,10 +86,7 @@ TEST(ClothFrictionLine, GradientMatchesFiniteDifferences) {
   auto sys = make_system(scene);
   Problem problem(scene, scene.time, *sys);
   for (double perturb : {0.0, 0.3}) {
-    std::mt19937_64 rng(7);
-    std::normal_distribution<double> normal(0.0, perturb * problem.control_scale());
-    VecX z = problem.initial_guess();
-    for (int i = 0; i < z.size(); ++i) z[i] += normal(rng);
+    const VecX z = test::perturbed_controls(problem, perturb * problem.control_scale(), 7);
     sys->release_step_schedule();
     problem.evaluate(z, nullptr);
     sys->hold_step_schedule(sys->step_schedule());

@@ -21,15 +21,21 @@ struct EndTarget : StateCost {
   }
 };
 
+// The problem's initial controls moved by seeded normal noise of standard deviation `sigma` (control units).
+inline VecX perturbed_controls(Problem& problem, double sigma, std::uint64_t seed) {
+  VecX z = problem.initial_guess();
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(0.0, sigma);
+  for (int i = 0; i < z.size(); ++i) z[i] += normal(rng);
+  return z;
+}
+
 // gradcheck (16 samples, seed 5, step eps) at the problem's initial controls moved by seeded normal noise
 // of each size in `perturbs` (0: the controls themselves); `report` gets each size and its result.
 inline void gradcheck_perturbed(Problem& problem, double eps, std::initializer_list<double> perturbs,
                                 const std::function<void(double, const GradcheckResult&)>& report) {
   for (double perturb : perturbs) {
-    VecX z = problem.initial_guess();
-    std::mt19937_64 rng(3);
-    std::normal_distribution<double> normal(0.0, perturb);
-    for (int i = 0; i < z.size(); ++i) z[i] += normal(rng);
+    const VecX z = perturbed_controls(problem, perturb, 3);
     report(perturb, gradcheck(problem, z, {.samples = 16, .eps = eps, .seed = 5}));
   }
 }
