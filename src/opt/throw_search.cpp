@@ -24,12 +24,17 @@ double radical_inverse(int k, int b) {
 
 }  // namespace
 
+double large_flight_share(int particles, int steps) {
+  const double per_flight = std::max(1.0, double(particles) * std::max(1, steps));
+  return std::min(1.0, kLargeFlight / per_flight);
+}
+
 int automatic_throw_count(int particles, int steps) {
   const double per_throw = std::max(1.0, double(particles) * std::max(1, steps));
-  // A large sheet's evaluations are dear too: beyond kLarge particle-steps a flight, the search's share of
-  // the run falls as the square of the flight's cost.
-  constexpr double kLarge = 12000;
-  const double large = per_throw > kLarge ? (kLarge / per_throw) * (kLarge / per_throw) : 1.0;
+  // A large sheet's evaluations are dear too: beyond kLargeFlight particle-steps a flight, the search's share
+  // of the run falls as the square of the flight's cost.
+  const double share = large_flight_share(particles, steps);
+  const double large = share * share;
   return int(std::clamp(4e6 / per_throw * large, 32.0, 512.0));
 }
 
@@ -120,19 +125,25 @@ ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int coun
   const FittedThrow fitted = refine_fitted_throw(problem, scene, kThrowCorrections);
   RigidFitOptions o;
   o.stop = stop;
-  // Each fit flies at most a quarter of the search's throws: `count` is what a large sheet's time allows.
+  // Each fit flies at most a quarter of the search's throws (`count` is what a large sheet's time allows), but
+  // never fewer than two Jacobians and their trials: below that a fit is cut before its second step, and a
+  // large sheet's rigid stage does the fit's work at an adjoint pass an evaluation. Only the quarter comes
+  // out of the search's throws.
+  constexpr int kMinFit = 30;
   const int quarter = std::max(1, count / 4);
-  o.max_simulations = std::clamp(budget - fitted.simulated, 0, std::min(kFirstFit, quarter));
+  const int fit_flights = std::max(kMinFit, quarter);
+  o.max_simulations = std::clamp(budget - fitted.simulated, 0, std::min(kFirstFit, fit_flights));
   std::vector<VecX> starts = {VecX::Zero(6)};
   if (fitted.z && *fitted.z != starts[0]) starts.push_back(*fitted.z);
   RigidThrowFit rigid = fit_rigid_throw(problem, scene, starts, o);
   // A throw the fit brought to the keyframes needs no search (the scene's throw is still flown, once).
   const int spent = fitted.simulated + rigid.simulated;
-  const int searched = rigid.reached() ? 0 : std::max(0, std::min(count - rigid.simulated, budget - spent));
+  const int searched =
+      rigid.reached() ? 0 : std::max(0, std::min(count - std::min(rigid.simulated, quarter), budget - spent));
   ThrowSearch s = search_throws(problem, searched, fitted, stop, &scene);
   s.simulated += rigid.simulated;
   if (!rigid.reached() && !s.met && s.z.size() == 6 && std::none_of(starts.begin(), starts.end(), [&](const VecX& a) { return a == s.z; })) {
-    o.max_simulations = std::clamp(budget - s.simulated, 0, quarter);
+    o.max_simulations = std::clamp(budget - s.simulated, 0, fit_flights);
     const RigidThrowFit more = fit_rigid_throw(problem, scene, {s.z}, o);
     s.simulated += more.simulated;
     absorb(rigid, more);
