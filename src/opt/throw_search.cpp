@@ -125,25 +125,19 @@ ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int coun
   const FittedThrow fitted = refine_fitted_throw(problem, scene, kThrowCorrections);
   RigidFitOptions o;
   o.stop = stop;
-  // Each fit flies at most a quarter of the search's throws (`count` is what a large sheet's time allows), but
-  // never fewer than two Jacobians and their trials: below that a fit is cut before its second step, and a
-  // large sheet's rigid stage does the fit's work at an adjoint pass an evaluation. Only the quarter comes
-  // out of the search's throws.
-  constexpr int kMinFit = 30;
+  // Each fit flies at most a quarter of the search's throws: `count` is what a large sheet's time allows.
   const int quarter = std::max(1, count / 4);
-  const int fit_flights = std::max(kMinFit, quarter);
-  o.max_simulations = std::clamp(budget - fitted.simulated, 0, std::min(kFirstFit, fit_flights));
+  o.max_simulations = std::clamp(budget - fitted.simulated, 0, std::min(kFirstFit, quarter));
   std::vector<VecX> starts = {VecX::Zero(6)};
   if (fitted.z && *fitted.z != starts[0]) starts.push_back(*fitted.z);
   RigidThrowFit rigid = fit_rigid_throw(problem, scene, starts, o);
   // A throw the fit brought to the keyframes needs no search (the scene's throw is still flown, once).
   const int spent = fitted.simulated + rigid.simulated;
-  const int searched =
-      rigid.reached() ? 0 : std::max(0, std::min(count - std::min(rigid.simulated, quarter), budget - spent));
+  const int searched = rigid.reached() ? 0 : std::max(0, std::min(count - rigid.simulated, budget - spent));
   ThrowSearch s = search_throws(problem, searched, fitted, stop, &scene);
   s.simulated += rigid.simulated;
   if (!rigid.reached() && !s.met && s.z.size() == 6 && std::none_of(starts.begin(), starts.end(), [&](const VecX& a) { return a == s.z; })) {
-    o.max_simulations = std::clamp(budget - s.simulated, 0, fit_flights);
+    o.max_simulations = std::clamp(budget - s.simulated, 0, quarter);
     const RigidThrowFit more = fit_rigid_throw(problem, scene, {s.z}, o);
     s.simulated += more.simulated;
     absorb(rigid, more);

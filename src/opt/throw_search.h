@@ -29,9 +29,8 @@ struct ThrowSearch {
 // A flight of more particle-steps than this is a large sheet's: the plan spends fewer evaluations on it.
 constexpr double kLargeFlight = 12000;
 
-// The share of a thrown sheet's max_evaluations its plan spends (opt/windows.cpp): 1 up to kLargeFlight
-// particle-steps a flight, then kLargeFlight over its particle-steps, so a large sheet's evaluations cost
-// about what a small sheet's budget does.
+// 1 up to kLargeFlight particle-steps a flight, then kLargeFlight over its particle-steps: a flight of
+// kLargeFlight particle-steps over this one in cost, before the solver's iterations a step grow with the sheet.
 double large_flight_share(int particles, int steps);
 
 // How many throws the automatic search simulates for a sheet of `particles` over `steps` steps: about four
@@ -49,9 +48,9 @@ ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted
 
 // What runs before a rigid first stage: Levenberg–Marquardt on the six rigid variables (opt/rigid_throw_fit.h)
 // from the scene's throw and the throw fitted to the keyframes; when that does not meet them, the search
-// (`count` throws less the fit's flights, at most a quarter of them) and the fit again from its best. Each fit
-// flies at most a quarter of `count` but at least 30 (at most 100 the first), so all of it takes about the
-// search's time, a little more for a large sheet's few throws; `budget` caps every flight together. The result's z is the best point of all, by φ.
+// (`count` throws less the fit's flights) and the fit again from its best. Each fit flies at most a quarter of
+// `count` (at most 100 the first), so all of it takes about the search's time; `budget` caps every flight
+// together. The result's z is the best point of all, by φ.
 ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int count, int budget,
                                   const std::atomic<bool>* stop = nullptr);
 

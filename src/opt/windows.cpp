@@ -187,13 +187,14 @@ double gradient_growth(Problem& problem, const VecX& z, int reference) {
 namespace {
 
 // Initial velocities: a search over rigid throws, the best rigid throw, a 3 x 3 lattice from it, then one
-// velocity per particle. A large sheet's stages share fewer evaluations (large_flight_share): where its
-// throw search and rigid fit leave it, the stages after it rarely gain, and each of their evaluations
-// costs several small sheets' flights.
+// velocity per particle. A large sheet's stages share fewer evaluations, large_flight_share to the power
+// 1.5: each of its evaluations costs several small sheets' (more particle-steps, and more conjugate-gradient
+// iterations a step as the sheet grows), and where its throw search and rigid fit leave it the stages
+// after them rarely gain.
 void plan_throw(const Scene& scene, StagePlan& plan) {
   const OptimizerSpec& o = scene.optimizer;
   const ControlSpec& c = scene.controls;
-  const double share = large_flight_share(scene.cloth->particles(), scene.time.steps());
+  const double share = std::pow(large_flight_share(scene.cloth->particles(), scene.time.steps()), 1.5);
   const int budget = std::max(std::min(o.max_evaluations, 3), int(std::lround(o.max_evaluations * share)));
   ControlSpec rigid = c;
   rigid.kind = ControlKind::kInitialRigidVelocity;
