@@ -145,6 +145,7 @@ TEST(Problem, ForcesFromAFrameOnAreZeroBeforeItAndTheirGradientIsExact) {
   TimeSpec coarse = fine;
   coarse.substeps = 2;
   ControlSpec spec;
+  spec.kind = ControlKind::kPerStep;  // steps, not frames, are remapped here
   spec.from_frame = 5;
   const Controls cf(spec, fine, 1, false, VecX::Zero(3), VecX::Zero(3));
   const Controls cc(spec, coarse, 1, false, VecX::Zero(3), VecX::Zero(3));
