@@ -98,7 +98,7 @@ inline const char* control_kind_name(ControlKind k) {
 constexpr double kInitialVelocityAlpha = 1e-6;
 
 struct ControlSpec {
-  ControlKind kind = ControlKind::kPerFrame;  // what every shipped scene uses (tests/results/shots/README.md)
+  ControlKind kind = ControlKind::kPerStep;
   double alpha = 1e-4;  // weight of the control effort ½α‖u‖² (forces' default; see kInitialVelocityAlpha)
   // Forces act from this frame on (per_step / per_frame); earlier steps are uncontrolled. A blend whose
   // start flails against the body is steered over its last frames, where the gradient stays finite.

@@ -379,7 +379,11 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& file, Pa
   }
   if (root.has("character")) s.character = parse_character_spec(root.child("character"), s);
   for (Block& b : root.array("objectives")) s.objectives.push_back(parse_objective(std::move(b), s));
-  s.controls = parse_controls(root.child("controls"), ControlsBlock::kScene, s.time.frames);
+  // A scene file without controls.kind gets per_frame forces, what every shipped scene asks for
+  // (tests/results/shots/README.md, "One default controls.kind").
+  ControlSpec scene_default;
+  scene_default.kind = ControlKind::kPerFrame;
+  s.controls = parse_controls(root.child("controls"), ControlsBlock::kScene, s.time.frames, scene_default);
   s.optimizer = parse_optimizer(root.child("optimizer"), s.controls, s.time.frames);
   {
     Block b = root.child("render");
