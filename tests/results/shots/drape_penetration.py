@@ -6,22 +6,25 @@ and the run's control force on that particle along the body's inward normal (per
   python3 tests/results/shots/drape_penetration.py KEYFRAME OUT.csv LABEL=RUN_DIR...
 
 Each RUN_DIR is a `keyframe optimize` or `keyframe simulate` run; it is exported (--format obj) first."""
-import glob, json, math, os, struct, subprocess, sys
+import json, math, os, struct, subprocess, sys
 
 
 def read_obj(path):
-    v, f = [], []
+    """The vertices and each group's triangles of one exported frame (`g cloth`, `g body`)."""
+    v, groups, g = [], {}, None
     for line in open(path):
         w = line.split()
         if not w:
             continue
         if w[0] == "v":
             v.append(tuple(float(a) for a in w[1:4]))
+        elif w[0] == "g":
+            g = w[1]
         elif w[0] == "f":
             idx = [int(a.split("/")[0]) - 1 for a in w[1:]]
             for k in range(1, len(idx) - 1):
-                f.append((idx[0], idx[k], idx[k + 1]))
-    return v, f
+                groups.setdefault(g, []).append((idx[0], idx[k], idx[k + 1]))
+    return v, groups
 
 
 def sub(a, b): return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
@@ -106,12 +109,13 @@ for label, run in runs:
     controls = os.path.join(run, "controls.bin")
     z = read_controls(controls) if os.path.exists(controls) else None
     for frame in range(frames + 1):
-        cloth = sorted(glob.glob(os.path.join(run, "export", f"cloth*{frame:04d}*.obj")))
-        body = sorted(glob.glob(os.path.join(run, "export", f"body*{frame:04d}*.obj")))
-        if not cloth or not body:
-            raise SystemExit(f"{run}/export: no cloth or body OBJ for frame {frame}")
-        x, _ = read_obj(cloth[0])
-        bv, bt = read_obj(body[0])
+        path = os.path.join(run, "export", f"frame_{frame:04d}.obj")
+        v, groups = read_obj(path)
+        if "cloth" not in groups or "body" not in groups:
+            raise SystemExit(f"{path}: no cloth or body group")
+        cloth_ids = sorted({i for tri in groups["cloth"] for i in tri})  # the particles, in order
+        x = [v[i] for i in cloth_ids]
+        bv, bt = v, groups["body"]
         sd = signed_distances(x, bv, bt)
         near = [(d, i) for i, (d, _) in enumerate(sd) if d is not None]
         row = {"run": label, "frame": frame}
