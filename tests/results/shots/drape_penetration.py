@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """How deep a drape goes into the body, frame by frame: each particle's signed distance to the body mesh
 (closest triangle, signed by that triangle's outward normal; negative inside), the deepest particle per frame,
-and the run's control force on that particle along the body's inward normal (per_frame forces, controls.bin).
+and the run's control force on that particle along the body's inward normal (per_frame forces, controls.bin), or
+for lattice forces the largest node force.
 
   python3 tests/results/shots/drape_penetration.py KEYFRAME OUT.csv LABEL=RUN_DIR...
 
@@ -129,9 +130,17 @@ for label, run in runs:
                 u = z[o:o + 3]
                 row["control_force_inward_N"] = round(-dot(u, sd[i][1]), 5)
                 row["control_force_N"] = round(math.sqrt(dot(u, u)), 5)
+            # Lattice forces (per_frame_lattice, the last frames): the largest node force over the frame, the
+            # force each particle at that node gets (the lattice is spread bilinearly, not shared out).
+            elif z is not None and len(z) % 27 == 0 and frame > frames - len(z) // 27:
+                o = (frame - 1 - (frames - len(z) // 27)) * 27
+                nodes = [z[o + 3 * k:o + 3 * k + 3] for k in range(9)]
+                u = max(nodes, key=lambda f: dot(f, f))
+                row["lattice_max_node_N"] = round(math.sqrt(dot(u, u)), 5)
+                row["lattice_max_node_up_N"] = round(u[1], 5)
         rows.append(row)
 fields = ["run", "frame", "min_signed_distance_m", "particle", "particles_inside", "control_force_inward_N",
-          "control_force_N"]
+          "control_force_N", "lattice_max_node_N", "lattice_max_node_up_N"]
 with open(out, "w") as f:
     f.write(",".join(fields) + "\n")
     for r in rows:
