@@ -1,6 +1,6 @@
 // cloth.self's whole-run adjoint at a fine step (h = 1/240): the folded irregular mesh, its two layers
 // closer than the self-contact thickness from the first step, sliding over each other on the ground, per-step
-// and per-frame forces at perturbed controls, central differences at two step sizes.
+// and per-frame forces at perturbed controls, central differences at two step sizes (eps 2e-4 and 1e-4).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -48,7 +48,8 @@ TEST(SelfContactFineStep, FoldedSheetsWholeRunGradientMatchesFiniteDifferences) 
       EXPECT_GT(std::abs(with - without), 1e-5 * std::abs(without)) << "the layers never touched";
       double grad_norm[2] = {0, 0};
       int k = 0;
-      for (double eps : {1e-4, 1e-5}) {
+      // Steps at which φ's round-off stays below the bound (eps 1e-5 does not: tests/results/shots/README.md).
+      for (double eps : {2e-4, 1e-4}) {
         const GradcheckResult r = gradcheck(problem, z, {.samples = 16, .eps = eps, .seed = 5});
         std::printf("self contact h = 1/%d %s perturb %g eps %g: max_rel_error %.2e, fd_spread %.2e, %d checked, "
                     "%d kinks, phi moved by self contact %.2e of itself\n",
