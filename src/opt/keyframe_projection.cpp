@@ -15,6 +15,25 @@ namespace kf {
 
 namespace {
 
+// The Levenberg–Marquardt damping and, when backtracking, the trust region on the largest change of one control.
+struct Damping {
+  double mu = -1, nu = 2, cap = 0;
+  void taken(double gain, double step, double max_step, bool backtrack) {
+    mu *= std::max(1.0 / 3, 1 - std::pow(2 * gain - 1, 3));
+    nu = 2;
+    if (backtrack && gain > 0.75) cap = std::min(max_step, std::max(cap, 2 * step));
+  }
+  void refused(double step, bool backtrack) {
+    if (backtrack) {
+      cap = step / 3;
+      mu *= 2;
+    } else {
+      mu *= nu;
+      nu *= 2;
+    }
+  }
+};
+
 class Projector {
  public:
   Projector(Problem& problem, std::vector<PlacedKeyframe> placed, double tolerance, const ProjectionOptions& o)
@@ -34,8 +53,8 @@ class Projector {
     out.start_worst = out.worst = worst / tolerance_;
     if (out.start_worst > o_.near_limit) return finish(out, ProjectionStop::kFar);
     double cost = 0.5 * r.squaredNorm();
-    double mu = -1, nu = 2;
-    double cap = max_step_;  // the largest change of one control in a step (shrunk by refusals when backtracking)
+    Damping d;
+    d.cap = max_step_;
     const double reach = o_.reach_share * tolerance_;
     for (;;) {
       if (worst <= reach) return finish(out, ProjectionStop::kReached);
@@ -48,15 +67,15 @@ class Projector {
       const Eigen::MatrixXd jk = metric_.times_kernel(jacobian_);
       const Eigen::MatrixXd a = jk * jacobian_.transpose();
       const double scale = std::max(1e-300, a.diagonal().maxCoeff());
-      if (mu < 0) mu = 1e-6 * scale;
+      if (d.mu < 0) d.mu = 1e-6 * scale;
       for (;;) {
         Eigen::MatrixXd damped = a;
-        damped.diagonal().array() += mu;
+        damped.diagonal().array() += d.mu;
         const VecX y = damped.ldlt().solve(rs);
         VecX dz = -(jk.transpose() * y);
         if (!dz.allFinite()) return finish(out, ProjectionStop::kStalled);
         const double largest = dz.cwiseAbs().maxCoeff();
-        const double shrink = largest > cap ? cap / largest : 1.0;
+        const double shrink = largest > d.cap ? d.cap / largest : 1.0;
         dz *= shrink;
         // The linearised residuals after the step: S r − shrink · A y.
         const double predicted = cost - 0.5 * (rs - shrink * (a * y)).squaredNorm();
@@ -66,10 +85,7 @@ class Projector {
         const double trial_cost = flew ? 0.5 * flight_.residuals().squaredNorm() : INFINITY;
         if (std::isnan(out.first_gain)) out.first_gain = predicted > 0 ? (cost - trial_cost) / predicted : -INFINITY;
         if (trial_cost < cost) {
-          const double gain = predicted > 0 ? (cost - trial_cost) / predicted : 0;
-          mu *= std::max(1.0 / 3, 1 - std::pow(2 * gain - 1, 3));
-          nu = 2;
-          if (o_.backtrack && gain > 0.75) cap = std::min(max_step_, std::max(cap, 2 * largest * shrink));
+          d.taken(predicted > 0 ? (cost - trial_cost) / predicted : 0, largest * shrink, max_step_, o_.backtrack);
           const bool negligible = cost - trial_cost <= 1e-12 * cost;
           z = trial_z;
           cost = trial_cost;
@@ -83,14 +99,8 @@ class Projector {
           break;
         }
         ++out.refused;
-        if (o_.backtrack) {
-          cap = largest * shrink / 3;
-          mu *= 2;
-        } else {
-          mu *= nu;
-          nu *= 2;
-        }
-        if (largest * shrink < 1e-12 || mu > 1e12 * scale) return finish(out, ProjectionStop::kStalled);
+        d.refused(largest * shrink, o_.backtrack);
+        if (largest * shrink < 1e-12 || d.mu > 1e12 * scale) return finish(out, ProjectionStop::kStalled);
       }
     }
   }
