@@ -88,3 +88,38 @@ TEST(NearMissWhy, DISABLED_AtARunsResult) {
 
 }  // namespace
 }  // namespace kf
+
+#include <fstream>
+#include <sstream>
+
+#include "app/optimize_job.h"
+#include "bench/bench_reachable.h"
+#include "../sim/character_test_util.h"
+
+namespace kf {
+namespace {
+
+// Not a check: reduced generated scenes of a class (KEYFRAME_CLASS, default drop-collider; indices 0 to
+// KEYFRAME_COUNT - 1) optimised at their defaults: each one's outcome and its near-miss projection's line.
+TEST(NearMissWhy, DISABLED_ReducedScenesOfAClass) {
+  const char* kind = std::getenv("KEYFRAME_CLASS");
+  const char* count = std::getenv("KEYFRAME_COUNT");
+  for (int index = 0; index < (count ? std::atoi(count) : 12); ++index) {
+    test::TempDir dir;
+    const ReachableScene g = generate_reachable(kind ? kind : "drop-collider", 52, index, true, dir.path());
+    std::ofstream(dir.path() / "scene.json") << g.scene.dump(1);
+    OptimizeOptions opt;
+    opt.quiet = true;
+    opt.out = (dir.path() / "run").string();
+    const OptimizeOutcome outcome = optimize_job(dir.path() / "scene.json", opt);
+    std::ifstream log(dir.path() / "run" / "log.txt");
+    std::string line, near;
+    while (std::getline(log, line))
+      if (line.rfind("near miss", 0) == 0) near = line;
+    std::cout << g.name << ": " << (outcome.failed ? "failed" : "ran") << ", " << outcome.diagnosis.substr(0, 160)
+              << "\n  " << near << "\n";
+  }
+}
+
+}  // namespace
+}  // namespace kf
