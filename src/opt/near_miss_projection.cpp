@@ -3,10 +3,20 @@
 #include <algorithm>
 #include <cmath>
 
+#include "opt/keyframe_residuals.h"
+#include "opt/keyframes/keyframe_common.h"
+
 namespace kf {
 
 int near_miss_passes(const NearMissRule& rule, int left, int max_evaluations) {
   return std::max(2 * std::max(0, left), int(std::lround(rule.min_share * max_evaluations)));
+}
+
+double near_miss_worst(Problem& problem, const Scene& scene) {
+  const std::vector<PlacedKeyframe> placed = placed_keyframes(problem, scene);
+  if (placed.empty() || !scene.cloth) return 0;
+  VecX r(residual_count(placed));
+  return keyframe_residuals(problem.rollout(), placed, false, r) / cloth_tolerance(scene);
 }
 
 KeyframeProjection project_near_miss(Problem& problem, const Scene& scene, const VecX& z,

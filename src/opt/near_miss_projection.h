@@ -24,6 +24,10 @@ struct NearMissRule {
 // The passes a projection after a run gets: `left` evaluations unspent of the scene's `max_evaluations`.
 int near_miss_passes(const NearMissRule& rule, int left, int max_evaluations);
 
+// The worst placed keyframe's distance in tolerances at the problem's last rollout (every state kept), as the
+// projection measures it; 0 when no keyframe places particles.
+double near_miss_worst(Problem& problem, const Scene& scene);
+
 // From z, the problem's controls at the run's end (its held step schedule held), with `unmet` the scene's
 // keyframes the run left outside their tolerance: the unmet keyframes first, then all
 // (project_unmet_then_all). kNotApplicable when none is unmet, kFar when the worst is not near.

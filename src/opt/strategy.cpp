@@ -478,6 +478,9 @@ void project_near_miss_at_end(Run& run) {
   if (run.scene.optimizer.soft_keyframes || !run.hooks.keyframes_unmet || !r.problem || r.interrupted ||
       r.stages.empty() || run.from_controls || r.reason == StopReason::kKeyframesReached || (run.stop && run.stop->load()))
     return;
+  const NearMissRule rule;
+  const int passes = near_miss_passes(rule, int(run.all_evaluations) - r.evaluations, run.scene.optimizer.max_evaluations);
+  if (passes < 2) return;  // the run spent its budget: not even judged again
   Problem& problem = *r.problem;
   const std::vector<double> stage_weights = problem.weight_scales();
   problem.set_weight_scales(run.weight_scales);
@@ -489,13 +492,15 @@ void project_near_miss_at_end(Run& run) {
   };
   std::vector<bool> unmet;
   const int before = unmet_at(r.z, unmet);
-  if (before > 0) {
-    const NearMissRule rule;
-    const int left = int(run.all_evaluations) - r.evaluations;
+  const double worst = before > 0 ? near_miss_worst(problem, run.scene) : 0;
+  if (before > 0 && worst > rule.near_limit) {
+    std::ostringstream os;
+    os << std::setprecision(3) << "near miss: not projected (the worst keyframe " << worst << " tolerances off, over "
+       << rule.near_limit << ")";
+    run.log.say(os.str());
+  } else if (before > 0) {
     const auto t0 = std::chrono::steady_clock::now();
-    const KeyframeProjection p =
-        project_near_miss(problem, run.scene, r.z, unmet, near_miss_passes(rule, left, run.scene.optimizer.max_evaluations),
-                          rule, run.stop);
+    const KeyframeProjection p = project_near_miss(problem, run.scene, r.z, unmet, passes, rule, run.stop);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (p.stop != ProjectionStop::kNotApplicable) {
       std::vector<bool> after_unmet;

@@ -203,6 +203,9 @@ TEST(NearMissProjection, LeavesAFarKeyframeAlone) {
   EXPECT_EQ(p.simulations, 1);
   EXPECT_EQ(p.adjoint_passes, 0);
   EXPECT_EQ(p.z, problem.initial_guess());
+  // What the strategy reads before starting one: the same worst keyframe, from the problem's own rollout.
+  problem.evaluate(problem.initial_guess(), nullptr);
+  EXPECT_NEAR(near_miss_worst(problem, scene), p.start_worst, 1e-9 * p.start_worst);
   const KeyframeProjection none =
       project_near_miss(problem, scene, problem.initial_guess(), {false, false}, 200, rule, nullptr);
   EXPECT_EQ(none.stop, ProjectionStop::kNotApplicable);
