@@ -197,7 +197,9 @@ OptimizeOutcome optimize_job(const fs::path& scene_file, const OptimizeOptions& 
   if (!setup.plan.why.empty() && !resuming) elog.say(setup.plan.why);
   OptimizeRun run;
   run.strategy = run_strategy(std::move(setup), job_hooks(scene, opt, max_memory, run), elog);
-  if (run.strategy.interrupted && run.strategy.evaluations == 0) return interrupted_before_evaluating(dir);
+  // A run stopped during its throw search still reports the best throw it flew (a cut job's report says how far).
+  if (run.strategy.interrupted && run.strategy.evaluations == 0 && !run.strategy.throw_search)
+    return interrupted_before_evaluating(dir);
 
   nlohmann::json report;
   naming_run_dir(staged, [&] { report = write_run_report(work, scene, resuming, run, elog); });

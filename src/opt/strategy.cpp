@@ -38,6 +38,7 @@ struct Run {
   std::vector<int> judged_until;      // per stage, the frame its keyframes count up to (opt/windows.h)
   std::vector<double> friction_scales;  // per stage, on the scene's friction (StagePlan::friction_scales)
   std::vector<VecX> stage_ends;       // each stage's best controls as the scene's own (opt/uncontrolled_floor.h)
+  int projected = 0;                  // a large sheet's evaluations spent in Gauss-Newton's passes (run_stage)
   StrategyResult r;
 };
 
@@ -249,25 +250,27 @@ void search_throws_first(Run& run) {
 // Before a thrown sheet's per-particle stage, when the stages before left a keyframe unmet: Gauss–Newton onto
 // the unmet keyframes, then onto all (opt/keyframe_projection.h), with at most the stage's evaluations in
 // simulations and adjoint passes; the stage starts from its result when that brings the worst keyframe nearer.
-void project_before_stage(Run& run, const StageSpec& stage) {
+// Returns the evaluations its passes were worth (a simulation and an adjoint pass each).
+int project_before_stage(Run& run, const StageSpec& stage) {
   StrategyResult& r = run.r;
   Problem& problem = *r.problem;
-  if (!run.hooks.keyframes_unmet) return;
+  if (!run.hooks.keyframes_unmet) return 0;
   problem.evaluate(r.z, nullptr);
-  if (problem.last_diverged()) return;
+  if (problem.last_diverged()) return 0;
   const std::vector<bool> unmet = run.hooks.keyframes_unmet(problem);
-  if (!any_unmet(unmet)) return;
+  if (!any_unmet(unmet)) return 0;
   ProjectionOptions o;
   o.max_passes = stage.max_evaluations;
   o.stop = run.stop;
   const auto t0 = std::chrono::steady_clock::now();
   const KeyframeProjection p = project_unmet_then_all(problem, run.scene, r.z, unmet, o);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (p.stop == ProjectionStop::kNotApplicable) return;
+  if (p.stop == ProjectionStop::kNotApplicable) return 0;
   std::ostringstream os;
   os << describe(p) << " in " << std::fixed << std::setprecision(2) << seconds << " s";
   run.log.say(os.str());
   if (p.improved()) r.z = p.z;
+  return (p.simulations + p.adjoint_passes + 1) / 2;
 }
 
 // optimizer.stop_when_reached, asked of the problem's last rollout. A checkpointed rollout keeps too few
@@ -318,9 +321,10 @@ void run_stage(Run& run, const std::vector<StageSpec>& stages, size_t s) {
   Problem& problem = *r.problem;
   if (from_controls_file) check_resumed_controls(run, problem, r.z);
   if (s == 0 && run.plan.throw_search > 0 && !from_controls_file) search_throws_first(run);
+  int projected = 0;  // the evaluations Gauss-Newton's passes were worth
   if (s > 0 && run.plan.throw_search > 0 && problem.controls().kind() == ControlKind::kInitialVelocity &&
       stages[s - 1].controls && !(run.stop && run.stop->load()))  // the first per-particle stage only
-    project_before_stage(run, stages[s]);
+    projected = project_before_stage(run, stages[s]);
   if (run.stop && run.stop->load()) {  // before the stage's first evaluation: no stage to record
     r.interrupted = true;
     r.reason = StopReason::kInterrupted;
@@ -332,6 +336,11 @@ void run_stage(Run& run, const std::vector<StageSpec>& stages, size_t s) {
   if (problem.checkpoint_every() == 0 && !memory_line.empty()) run.log.say(memory_line);
   OptimizerSpec spec = run.scene.optimizer;
   spec.max_evaluations = stages[s].max_evaluations;
+  // A large sheet's plan (opt/windows.cpp) spends its stage's evaluations once: Gauss-Newton's passes count.
+  if (projected > 0 && run.scene.cloth && large_flight_share(run.scene.cloth->particles(), run.scene.time.steps()) < 1) {
+    spec.max_evaluations = std::max(1, spec.max_evaluations - projected);
+    run.projected += projected;
+  }
   if (spec.first_step < 0) spec.first_step = run.scaled_first_step ? problem.control_scale() : 0;
   RestartHooks hooks;
   const int substeps = r.time.substeps;
@@ -443,7 +452,7 @@ void press_missed_keyframes(Run& run, std::vector<StageSpec>& stages) {
     if (problem.last_diverged()) return;
     const std::vector<bool> unmet = run.hooks.keyframes_unmet(problem);
     if (!any_unmet(unmet)) return;
-    const int left = int(run.all_evaluations) - r.evaluations;
+    const int left = int(run.all_evaluations) - r.evaluations - run.projected;
     if (left < rule.min_evaluations) return;
     const double before = scene_keyframe_terms(problem);
     std::vector<std::string> names;

@@ -24,12 +24,17 @@ double radical_inverse(int k, int b) {
 
 }  // namespace
 
+double large_flight_share(int particles, int steps) {
+  const double per_flight = std::max(1.0, double(particles) * std::max(1, steps));
+  return std::min(1.0, kLargeFlight / per_flight);
+}
+
 int automatic_throw_count(int particles, int steps) {
   const double per_throw = std::max(1.0, double(particles) * std::max(1, steps));
-  // A large sheet's evaluations are dear too: beyond kLarge particle-steps a flight, the search's share of
-  // the run falls as the square of the flight's cost.
-  constexpr double kLarge = 12000;
-  const double large = per_throw > kLarge ? (kLarge / per_throw) * (kLarge / per_throw) : 1.0;
+  // A large sheet's evaluations are dear too: beyond kLargeFlight particle-steps a flight, the search's share
+  // of the run falls as the square of the flight's cost.
+  const double share = large_flight_share(particles, steps);
+  const double large = share * share;
   return int(std::clamp(4e6 / per_throw * large, 32.0, 512.0));
 }
 

@@ -26,6 +26,13 @@ struct ThrowSearch {
   std::optional<RigidThrowFit> rigid;  // Levenberg–Marquardt on (Δv, ω) after the search (search_and_fit_throws)
 };
 
+// A flight of more particle-steps than this is a large sheet's: the plan spends fewer evaluations on it.
+constexpr double kLargeFlight = 12000;
+
+// 1 up to kLargeFlight particle-steps a flight, then kLargeFlight over its particle-steps: a flight of
+// kLargeFlight particle-steps over this one in cost, before the solver's iterations a step grow with the sheet.
+double large_flight_share(int particles, int steps);
+
 // How many throws the automatic search simulates for a sheet of `particles` over `steps` steps: about four
 // million particle-steps, fewer for a flight of more than 12000 (times (12000 / its particle-steps)²), between
 // 32 and 512 throws.

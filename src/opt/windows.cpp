@@ -187,19 +187,24 @@ double gradient_growth(Problem& problem, const VecX& z, int reference) {
 namespace {
 
 // Initial velocities: a search over rigid throws, the best rigid throw, a 3 x 3 lattice from it, then one
-// velocity per particle.
+// velocity per particle. A large sheet's stages share fewer evaluations, large_flight_share to the power
+// 1.5: each of its evaluations costs several small sheets' (more particle-steps, and more conjugate-gradient
+// iterations a step as the sheet grows), and where its throw search and rigid fit leave it the stages
+// after them rarely gain.
 void plan_throw(const Scene& scene, StagePlan& plan) {
   const OptimizerSpec& o = scene.optimizer;
   const ControlSpec& c = scene.controls;
+  const double share = std::pow(large_flight_share(scene.cloth->particles(), scene.time.steps()), 1.5);
+  const int budget = std::max(std::min(o.max_evaluations, 3), int(std::lround(o.max_evaluations * share)));
   ControlSpec rigid = c;
   rigid.kind = ControlKind::kInitialRigidVelocity;
-  const int rigid_budget = std::clamp(o.max_evaluations / 3, 1, 40);
+  const int rigid_budget = std::clamp(budget / 3, 1, 40);
   ControlSpec lattice = c;
   lattice.kind = ControlKind::kInitialLatticeVelocity;
-  const int lattice_budget = std::clamp((o.max_evaluations - rigid_budget) / 3, 0, 60);
+  const int lattice_budget = std::clamp((budget - rigid_budget) / 3, 0, 60);
   plan.stages = {{scene.time.substeps, rigid_budget, rigid}};
   if (lattice_budget > 0) plan.stages.push_back({scene.time.substeps, lattice_budget, lattice});
-  plan.stages.push_back({scene.time.substeps, o.max_evaluations - rigid_budget - lattice_budget, std::nullopt});
+  plan.stages.push_back({scene.time.substeps, budget - rigid_budget - lattice_budget, std::nullopt});
   // The automatic search spends at most twice the budget in throws (each a simulation without its adjoint
   // pass): a budget the user cut cuts the search too.
   plan.throw_search = o.throw_search >= 0 ? o.throw_search
@@ -208,6 +213,10 @@ void plan_throw(const Scene& scene, StagePlan& plan) {
   plan.why = "stages: a search over " + std::to_string(plan.throw_search) +
              " rigid throws, the best rigid throw (6 variables), a 3 x 3 lattice of initial velocities over the "
              "sheet from it, then one initial velocity per particle";
+  if (budget < o.max_evaluations)
+    plan.why += " (" + std::to_string(budget) + " of the " + std::to_string(o.max_evaluations) +
+                " evaluations: a flight of " + std::to_string(scene.cloth->particles() * scene.time.steps()) +
+                " particle-steps)";
   plan.scaled_first_step = true;
 }
 
