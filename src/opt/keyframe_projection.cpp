@@ -43,7 +43,7 @@ class Projector {
         max_step_(o.max_step * problem.control_scale()),
         x0_(initial_positions(problem)),
         metric_(problem.controls(), x0_, problem.system().planar(), o.smooth),
-        sketched_(sketched(flight_.placed())) {}
+        sketched_(o.sketch && sketched(flight_.placed())) {}
 
   void run(VecX z, KeyframeProjection& out) {
     if (!flight_.fly(z)) return finish(out, ProjectionStop::kDiverged);
@@ -126,7 +126,7 @@ class Projector {
   // One adjoint pass per row of the sketch (opt/residual_sketch.h; every residual when nothing is sketched)
   // over the last flight, whose residuals are r: the rows of S dr/dz.
   bool jacobian(const VecX& r) {
-    sketch_ = residual_sketch(flight_.placed(), x0_, r);
+    sketch_ = sketched_ ? residual_sketch(flight_.placed(), x0_, r) : Eigen::MatrixXd::Identity(r.size(), r.size());
     VecX w, row;
     for (long k = 0; k < sketch_.rows(); ++k) {
       if (out_of_budget()) return false;
@@ -160,7 +160,8 @@ KeyframeProjection project_onto_keyframes(Problem& problem, const Scene& scene, 
   if (placed.empty() || !all_placed || !scene.cloth || problem.size() == 0) return out;
   VecX x0, v0;
   problem.system().initial_state(x0, v0);
-  const long rows = residual_sketch(placed, x0, VecX()).rows() + (sketched(placed) ? 1 : 0);
+  const bool sketch = options.sketch && sketched(placed);
+  const long rows = sketch ? residual_sketch(placed, x0, VecX()).rows() + 1 : residual_count(placed);
   if (2 * rows > options.max_passes) return out;
   Projector projector(problem, std::move(placed), cloth_tolerance(scene), options);
   projector.run(z, out);

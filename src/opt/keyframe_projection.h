@@ -44,6 +44,9 @@ struct ProjectionOptions {
   // (Levenberg–Marquardt). Where the flight is linear only over a tenth of the Gauss–Newton step, the damping
   // takes many refused trials to get there.
   bool backtrack = false;
+  // A keyframe on many particles as its moments plus the residual vector (opt/residual_sketch.h), a Jacobian
+  // of about 31 adjoint passes; else three rows per particle.
+  bool sketch = false;
   const std::atomic<bool>* stop = nullptr;
 };
 

@@ -31,6 +31,7 @@ KeyframeProjection project_near_miss(Problem& problem, const Scene& scene, const
   o.near_limit = rule.near_limit;
   o.stop = stop;
   o.backtrack = rule.backtrack;
+  o.sketch = true;
   return project_unmet_then_all(problem, scene, z, unmet, o);
 }
 

@@ -65,6 +65,7 @@ KeyframeProjection project(const std::string& kind, const std::string& objective
   o.reach_share = 0.01;
   o.max_passes = 400;
   o.max_step = 1e3;  // the linear model holds everywhere: no cap on the step
+  o.sketch = true;
   return project_onto_keyframes(problem, scene, problem.initial_guess(), o);
 }
 
