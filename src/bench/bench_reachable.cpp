@@ -81,7 +81,7 @@ SceneRun run_scene(const ReachableSweepOptions& o, const std::string& name, cons
   }
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   run.cpu_seconds = process_cpu_seconds() - cpu_start;
-  // A job cut before its first evaluation (a long throw search) writes no run directory: no report.
+  // A job cut before its first evaluation writes no run directory (one cut in its throw search reports its best throw).
   if (!std::filesystem::exists(run.outcome.dir / "report.json")) return run;
   std::ifstream in(run.outcome.dir / "report.json");
   run.report = nlohmann::json::parse(in);

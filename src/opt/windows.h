@@ -20,7 +20,8 @@
 //    where a force on the sheet as a whole still moves it (a cape on a swinging body). A tame gradient (a sheet in free flight) keeps one stage.
 //  - per-particle initial velocities start from the best rigid throw (six numbers; ring-toss.json's stages),
 //    found by a search over throws and then L-BFGS, bent by a 3 x 3 lattice of velocities over the sheet
-//    (27 numbers, smooth over it) before every particle gets its own.
+//    (27 numbers, smooth over it) before every particle gets its own. A flight of more than 12000
+//    particle-steps shares fewer of the evaluations (opt/throw_search.h's large_flight_share to the power 1.5).
 // Flocks, whose gradients stay tame, run in one stage.
 #include <string>
 #include <vector>

@@ -142,7 +142,8 @@ TEST(Robustness, CapeOnAZUpBlenderFigureLiftsItsHemFromWhereItHangs) {
 }
 
 // A blanket hung from the shoulders of the Z-up SMD Wuson at half its size (scale 0.5, up_axis "z"; the
-// anchors in metres after both): unaided it slides off the -x flank, 35 cm from the hem's mark on the rump.
+// anchors in metres after both): unaided it slides off the -x flank, far from the hem's mark on the rump
+// (tests/results/shots/README.md).
 TEST(Robustness, CapeOnAHalfScaleZUpSmdCreatureKeepsItsHemOnTheBack) {
   const json scene = suite_scene("cape-wuson-smd");
   ASSERT_EQ(scene.at("character").at("scale"), 0.5);
@@ -158,9 +159,9 @@ TEST(Robustness, CapeOnAHalfScaleZUpSmdCreatureKeepsItsHemOnTheBack) {
 }
 
 // A free 12 x 12 sheet dropped onto the still Collada/human.zae (no anchors), its centre of mass asked to be
-// over the right shoulder. Frictionless, unaided it slides off the shoulder and falls (90 cm away) and the
-// optimiser stalls 8 cm short; with friction 0.5 on the body (cloth on clothing) it stays on the shoulder,
-// 18 cm below the mark, and reaches it at defaults.
+// over the right shoulder. Frictionless, unaided it slides off the shoulder and falls, and the optimiser
+// stalls short of the mark; with friction 0.5 on the body (cloth on clothing) it stays on the shoulder, below
+// the mark, and reaches it at defaults (tests/results/shots/README.md, "The drape, with friction on the body").
 TEST(Robustness, SheetDroppedOnAStillFigureDrapesOverItsRightShoulder) {
   const json scene = suite_scene("drape-human");
   ASSERT_FALSE(scene.at("character").contains("anchors"));
