@@ -261,6 +261,7 @@ int project_before_stage(Run& run, const StageSpec& stage) {
   if (!any_unmet(unmet)) return 0;
   ProjectionOptions o;
   o.max_passes = stage.max_evaluations;
+  o.sketch = true;  // a keyframe on many particles costs a Jacobian of its moments, not three rows a particle
   o.stop = run.stop;
   const auto t0 = std::chrono::steady_clock::now();
   const KeyframeProjection p = project_unmet_then_all(problem, run.scene, r.z, unmet, o);
