@@ -10,6 +10,7 @@
 #include "opt/friction_continuation.h"
 #include "opt/keyframe_projection.h"
 #include "opt/keyframe_weights.h"
+#include "opt/near_miss_projection.h"
 #include "opt/restarts.h"
 #include "opt/term_breakdown.h"
 #include "opt/throw_fit.h"
@@ -260,6 +261,7 @@ int project_before_stage(Run& run, const StageSpec& stage) {
   if (!any_unmet(unmet)) return 0;
   ProjectionOptions o;
   o.max_passes = stage.max_evaluations;
+  o.sketch = true;  // a keyframe on many particles costs a Jacobian of its moments, not three rows a particle
   o.stop = run.stop;
   const auto t0 = std::chrono::steady_clock::now();
   const KeyframeProjection p = project_unmet_then_all(problem, run.scene, r.z, unmet, o);
@@ -478,6 +480,53 @@ void press_missed_keyframes(Run& run, std::vector<StageSpec>& stages) {
   }
 }
 
+// A run that ended with a keyframe unmet but near: Gauss–Newton onto the keyframes from its best point
+// (opt/near_miss_projection.h), kept when it leaves no more keyframes unmet and the worst nearer. A run that met
+// its keyframes is not touched.
+void project_near_miss_at_end(Run& run) {
+  StrategyResult& r = run.r;
+  if (run.scene.optimizer.soft_keyframes || !run.hooks.keyframes_unmet || !r.problem || r.interrupted ||
+      r.stages.empty() || run.from_controls || r.reason == StopReason::kKeyframesReached || (run.stop && run.stop->load()))
+    return;
+  const NearMissRule rule;
+  const int passes = near_miss_passes(rule, int(run.all_evaluations) - r.evaluations, run.scene.optimizer.max_evaluations);
+  if (passes < 2) return;  // the run spent its budget: not even judged again
+  Problem& problem = *r.problem;
+  const std::vector<double> stage_weights = problem.weight_scales();
+  problem.set_weight_scales(run.weight_scales);
+  const auto unmet_at = [&](const VecX& z, std::vector<bool>& unmet) {
+    problem.evaluate(z, nullptr);
+    if (problem.last_diverged()) return -1;
+    unmet = run.hooks.keyframes_unmet(problem);
+    return int(std::count(unmet.begin(), unmet.end(), true));
+  };
+  std::vector<bool> unmet;
+  const int before = unmet_at(r.z, unmet);
+  const double worst = before > 0 ? near_miss_worst(problem, run.scene) : 0;
+  if (before > 0 && worst > rule.near_limit) {
+    std::ostringstream os;
+    os << std::setprecision(3) << "near miss: not projected (the worst keyframe " << worst << " tolerances off, over "
+       << rule.near_limit << ")";
+    run.log.say(os.str());
+  } else if (before > 0) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const KeyframeProjection p = project_near_miss(problem, run.scene, r.z, unmet, passes, rule, run.stop);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (p.stop != ProjectionStop::kNotApplicable) {
+      std::vector<bool> after_unmet;
+      const int after = p.improved() ? unmet_at(p.z, after_unmet) : -1;
+      const bool keep = after >= 0 && after <= before;
+      std::ostringstream os;
+      os << "near miss: " << describe(p) << " in " << std::fixed << std::setprecision(2) << seconds << " s; "
+         << (keep ? "kept" : "not kept") << " (" << before << " keyframe" << (before == 1 ? "" : "s") << " unmet before, "
+         << (after < 0 ? std::string("not judged") : std::to_string(after)) << " after)";
+      run.log.say(os.str());
+      if (keep) r.z = p.z;
+    }
+  }
+  problem.set_weight_scales(stage_weights);
+}
+
 // A run that ended in a window with forces held before it (interrupted, or its last stages skipped) gives
 // its result in the scene's own controls, the held forces included: what controls.bin, a resume and the
 // report read.
@@ -545,6 +594,7 @@ StrategyResult run_strategy(StrategySetup setup, const StrategyHooks& hooks, Str
   run_stages(run, stages, 0);
   windows_after_early_end(run, stages);
   press_missed_keyframes(run, stages);
+  project_near_miss_at_end(run);
   release_held_forces(run);
   r.weight_scales = run.weight_scales;
   if (r.problem) r.problem->set_weight_scales({});
