@@ -1,14 +1,19 @@
 #!/usr/bin/env python3
 """Merges reachable.csv files of `keyframe bench --only reachable` runs (a run split over classes, or cut off
 before its class table) into one table a class: scenes, passed, pass rate, median evaluations, median and
-worst wall seconds, median and worst CPU seconds, and a row "all".
+worst wall seconds, median and worst CPU seconds, and a row "all". A scene in more than one file counts once,
+as the last file measured it (a rerun of some scenes at a later commit replaces their earlier rows).
 
 Usage: scripts/reachable_classes.py OUT.csv IN.csv ..."""
 import csv, statistics, sys
 
 if len(sys.argv) < 3:
     raise SystemExit(__doc__)
-rows = [r for f in sys.argv[2:] for r in csv.DictReader(open(f))]
+by_scene = {}
+for f in sys.argv[2:]:
+    for r in csv.DictReader(open(f)):
+        by_scene[r["scene"]] = r
+rows = list(by_scene.values())
 groups = {}
 for r in rows:
     groups.setdefault(r["class"], []).append(r)

@@ -195,7 +195,9 @@ void plan_throw(const Scene& scene, StagePlan& plan) {
   const OptimizerSpec& o = scene.optimizer;
   const ControlSpec& c = scene.controls;
   const double share = std::pow(large_flight_share(scene.cloth->particles(), scene.time.steps()), 1.5);
-  const int budget = std::max(std::min(o.max_evaluations, 3), int(std::lround(o.max_evaluations * share)));
+  // Never below what three stages need to get past their line searches' first trials.
+  const int budget = std::max(std::min(o.max_evaluations, 3 * kMinStageEvaluations),
+                              int(std::lround(o.max_evaluations * share)));
   ControlSpec rigid = c;
   rigid.kind = ControlKind::kInitialRigidVelocity;
   const int rigid_budget = std::clamp(budget / 3, 1, 40);

@@ -59,9 +59,12 @@ TEST(ThrowLargeSheet, ThePlanSpendsFewerEvaluationsWhenAFlightIsDear) {
   EXPECT_EQ(large.stages[1].max_evaluations, 32);
   EXPECT_EQ(large.stages[2].max_evaluations, 65);
   EXPECT_NE(large.why.find("137 of the 300 evaluations"), std::string::npos) << large.why;
-  // A user's small budget is kept, never raised; two evaluations still plan a rigid and a per-particle stage.
+  // Never below three stages' 12 evaluations each: a 50 x 50 sheet over 60 steps (the ring toss's size) keeps
+  // 36 of 120, where the share alone would leave 3.
+  EXPECT_EQ(planned(plan_stages(thrown_scene(50, 60, R"({"max_evaluations": 120})"))), 36);
+  // A user's small budget is kept whole, never raised; two evaluations still plan a rigid and a per-particle stage.
   EXPECT_EQ(planned(plan_stages(thrown_scene(26, 30, R"({"max_evaluations": 2})"))), 2);
-  EXPECT_EQ(planned(plan_stages(thrown_scene(26, 30, R"({"max_evaluations": 4})"))), 3);
+  EXPECT_EQ(planned(plan_stages(thrown_scene(26, 30, R"({"max_evaluations": 4})"))), 4);
 }
 
 // Position keyframes on three particles at the last frame, where the rigid throw z carries an n x n sheet.
