@@ -263,21 +263,6 @@ TEST(ClothMeshAdjoint, MatchesFiniteDifferencesInContactAtPerturbedControls) {
   }
 }
 
-// The folded irregular mesh lying on the ground with friction, pinned at one corner region of its lower layer;
-// `self` is the scene's cloth.self block.
-Scene folded_scene(const std::filesystem::path& dir, const std::filesystem::path& file, const char* controls,
-                   int substeps, const std::string& self) {
-  return parse_scene(
-      std::string(R"({"time": {"fps": 30, "frames": 3, "substeps": )") + std::to_string(substeps) +
-          R"(}, "cloth": {"mesh": {"file": ")" + file.string() + R"("}, "mass": 0.1, "solver": "direct",
-          "velocity": [0.6, 0, 0.2], "pins": {"min": [-1, -1, -1], "max": [-0.1, 0.015, -0.1]}, "self": )" + self + R"(,
-          "colliders": [{"type": "ground", "thickness": 0.015, "stiffness": 3000, "friction": 0.5}]},
-          "controls": )" + controls + R"(,
-          "objectives": [{"type": "position", "frame": 3, "weight": 100,
-                          "particles": {"min": [-1, 0.015, -1], "max": [1, 1, 1]}, "targets": [[0.05, 0.03, 0]]}]})",
-      dir / "folded.json");
-}
-
 // The whole step's exact adjoint with `cloth.self` on the folded irregular mesh: the upper layer slides over
 // the lower (pair contact and pair friction from the first step: the scene's objective differs without them),
 // per-step and per-frame forces at zero and perturbed controls.
@@ -287,11 +272,11 @@ TEST(ClothMeshAdjoint, SelfContactOfAFoldedMeshMatchesFiniteDifferences) {
   const std::string self = R"({"enabled": true, "thickness": 0.01, "stiffness": 500, "friction": 0.3})";
   for (const char* controls : {R"({"kind": "per_step", "alpha": 1e-4})", R"({"kind": "per_frame", "alpha": 1e-4})"})
     for (int substeps : {1, 4}) {
-      const Scene scene = folded_scene(dir.path(), file, controls, substeps, self);
+      const Scene scene = test::folded_mesh_scene(dir.path(), file, controls, substeps, self);
       auto sys = make_system(scene);
       Problem problem(scene, scene.time, *sys);
       {
-        const Scene apart = folded_scene(dir.path(), file, controls, substeps, R"({"enabled": false})");
+        const Scene apart = test::folded_mesh_scene(dir.path(), file, controls, substeps, R"({"enabled": false})");
         auto apart_sys = make_system(apart);
         Problem apart_problem(apart, apart.time, *apart_sys);
         const VecX z = problem.initial_guess();

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "scene/cloth_spec.h"
+#include "scene/scene.h"
 
 namespace kf::test {
 
@@ -108,6 +109,21 @@ inline std::filesystem::path write_folded_irregular_obj(const std::filesystem::p
   const auto file = dir / "folded.obj";
   write_obj(file, v, faces);
   return file;
+}
+
+// The folded irregular mesh lying on the ground with friction, pinned at one corner region of its lower layer;
+// `self` is the scene's cloth.self block.
+inline Scene folded_mesh_scene(const std::filesystem::path& dir, const std::filesystem::path& file, const char* controls,
+                               int substeps, const std::string& self) {
+  return parse_scene(
+      std::string(R"({"time": {"fps": 30, "frames": 3, "substeps": )") + std::to_string(substeps) +
+          R"(}, "cloth": {"mesh": {"file": ")" + file.string() + R"("}, "mass": 0.1, "solver": "direct",
+          "velocity": [0.6, 0, 0.2], "pins": {"min": [-1, -1, -1], "max": [-0.1, 0.015, -0.1]}, "self": )" + self + R"(,
+          "colliders": [{"type": "ground", "thickness": 0.015, "stiffness": 3000, "friction": 0.5}]},
+          "controls": )" + controls + R"(,
+          "objectives": [{"type": "position", "frame": 3, "weight": 100,
+                          "particles": {"min": [-1, 0.015, -1], "max": [1, 1, 1]}, "targets": [[0.05, 0.03, 0]]}]})",
+      dir / "folded.json");
 }
 
 }  // namespace kf::test

@@ -18,28 +18,15 @@ namespace {
 
 constexpr int kSubsteps = 8;  // 30 frames a second: h = 1/240
 
-Scene folded(const std::filesystem::path& dir, const std::filesystem::path& file, const char* controls,
-             const char* self) {
-  return parse_scene(
-      std::string(R"({"time": {"fps": 30, "frames": 3, "substeps": )") + std::to_string(kSubsteps) +
-          R"(}, "cloth": {"mesh": {"file": ")" + file.string() + R"("}, "mass": 0.1, "solver": "direct",
-          "velocity": [0.6, 0, 0.2], "pins": {"min": [-1, -1, -1], "max": [-0.1, 0.015, -0.1]}, "self": )" + self + R"(,
-          "colliders": [{"type": "ground", "thickness": 0.015, "stiffness": 3000, "friction": 0.5}]},
-          "controls": )" + controls + R"(,
-          "objectives": [{"type": "position", "frame": 3, "weight": 100,
-                          "particles": {"min": [-1, 0.015, -1], "max": [1, 1, 1]}, "targets": [[0.05, 0.03, 0]]}]})",
-      dir / "folded.json");
-}
-
 TEST(SelfContactFineStep, FoldedSheetsWholeRunGradientMatchesFiniteDifferences) {
   test::MeshDir dir;
   const auto file = test::write_folded_irregular_obj(dir.path(), Vec3(0, 0.012, 0), 0.3, 0.007, Vec3(0.003, 0, 0.002));
   const char* self = R"({"enabled": true, "thickness": 0.01, "stiffness": 500, "friction": 0.3})";
   for (const char* controls : {R"({"kind": "per_step", "alpha": 1e-4})", R"({"kind": "per_frame", "alpha": 1e-4})"}) {
-    const Scene scene = folded(dir.path(), file, controls, self);
+    const Scene scene = test::folded_mesh_scene(dir.path(), file, controls, kSubsteps, self);
     auto sys = make_system(scene);
     Problem problem(scene, scene.time, *sys);
-    const Scene apart = folded(dir.path(), file, controls, R"({"enabled": false})");
+    const Scene apart = test::folded_mesh_scene(dir.path(), file, controls, kSubsteps, R"({"enabled": false})");
     auto apart_sys = make_system(apart);
     Problem apart_problem(apart, apart.time, *apart_sys);
     for (double perturb : {0.01, 0.1}) {
