@@ -18,6 +18,7 @@
 #include "opt/problem.h"
 #include "scene/scene.h"
 #include "sim/make_system.h"
+#include "residual_flight_check.h"
 
 namespace kf {
 namespace {
@@ -56,20 +57,13 @@ TEST(KeyframeProjection, ResidualAdjointMatchesCentralDifferencesInContact) {
     const VecX z = perturbed(problem, size, 11);
     ASSERT_TRUE(flight.fly(z));
     sys->hold_step_schedule(sys->step_schedule());  // a split step that flips between sides is a jump
-    VecX w(flight.rows()), d(problem.size()), g;
+    VecX w(flight.rows()), d(problem.size());
     for (auto& e : w) e = normal(rng);
     for (auto& e : d) e = normal(rng);
     d /= d.norm();
-    ASSERT_TRUE(flight.fly(z));
-    ASSERT_TRUE(flight.transpose_times(w, g));
-    const double analytic = g.dot(d);
-    const auto central = [&](double h) {
-      EXPECT_TRUE(flight.fly(z + h * d));
-      const double plus = w.dot(flight.residuals());
-      EXPECT_TRUE(flight.fly(z - h * d));
-      return (plus - w.dot(flight.residuals())) / (2 * h);
-    };
-    const double coarse = central(1e-5), fine = central(1e-6);
+    const test::ResidualDirectional c = test::residual_directional(flight, z, w, d, 1e-5, 1e-6);
+    ASSERT_TRUE(c.ok);
+    const double analytic = c.analytic, coarse = c.coarse, fine = c.fine;
     EXPECT_GT(std::abs(analytic), 1e-3);
     EXPECT_NEAR(coarse, fine, 1e-5 * std::abs(fine));
     EXPECT_NEAR(analytic, fine, 1e-5 * std::abs(fine)) << "coarse " << coarse;
