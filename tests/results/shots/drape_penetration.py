@@ -101,47 +101,52 @@ def read_controls(path):
     return struct.unpack_from(f"<{count}d", data, 20)
 
 
-keyframe, out, runs = sys.argv[1], sys.argv[2], [a.split("=", 1) for a in sys.argv[3:]]
-rows = []
-for label, run in runs:
-    subprocess.run([keyframe, "export", run, "--format", "obj"], check=True, capture_output=True)
-    scene = json.load(open(os.path.join(run, "scene.json")))
-    frames = scene["time"]["frames"]
-    controls = os.path.join(run, "controls.bin")
-    z = read_controls(controls) if os.path.exists(controls) else None
-    for frame in range(frames + 1):
-        path = os.path.join(run, "export", f"frame_{frame:04d}.obj")
-        v, groups = read_obj(path)
-        if "cloth" not in groups or "body" not in groups:
-            raise SystemExit(f"{path}: no cloth or body group")
-        cloth_ids = sorted({i for tri in groups["cloth"] for i in tri})  # the particles, in order
-        x = [v[i] for i in cloth_ids]
-        bv, bt = v, groups["body"]
-        sd = signed_distances(x, bv, bt)
-        near = [(d, i) for i, (d, _) in enumerate(sd) if d is not None]
-        row = {"run": label, "frame": frame}
-        if near:
-            d, i = min(near)
-            row.update({"min_signed_distance_m": round(d, 5), "particle": i,
-                        "particles_inside": sum(1 for d, _ in near if d < 0)})
-            # The force over the frame that ends here (block f-1 acts from frame f-1 to f), along the inward normal.
-            if z is not None and frame >= 1 and len(z) == frames * 3 * len(x):
-                o = (frame - 1) * 3 * len(x) + 3 * i
-                u = z[o:o + 3]
-                row["control_force_inward_N"] = round(-dot(u, sd[i][1]), 5)
-                row["control_force_N"] = round(math.sqrt(dot(u, u)), 5)
-            # Lattice forces (per_frame_lattice, the last frames): the largest node force over the frame, the
-            # force each particle at that node gets (the lattice is spread bilinearly, not shared out).
-            elif z is not None and len(z) % 27 == 0 and frame > frames - len(z) // 27:
-                o = (frame - 1 - (frames - len(z) // 27)) * 27
-                nodes = [z[o + 3 * k:o + 3 * k + 3] for k in range(9)]
-                u = max(nodes, key=lambda f: dot(f, f))
-                row["lattice_max_node_N"] = round(math.sqrt(dot(u, u)), 5)
-                row["lattice_max_node_up_N"] = round(u[1], 5)
-        rows.append(row)
-fields = ["run", "frame", "min_signed_distance_m", "particle", "particles_inside", "control_force_inward_N",
-          "control_force_N", "lattice_max_node_N", "lattice_max_node_up_N"]
-with open(out, "w") as f:
-    f.write(",".join(fields) + "\n")
-    for r in rows:
-        f.write(",".join(str(r.get(k, "")) for k in fields) + "\n")
+def main():
+    keyframe, out, runs = sys.argv[1], sys.argv[2], [a.split("=", 1) for a in sys.argv[3:]]
+    rows = []
+    for label, run in runs:
+        subprocess.run([keyframe, "export", run, "--format", "obj"], check=True, capture_output=True)
+        scene = json.load(open(os.path.join(run, "scene.json")))
+        frames = scene["time"]["frames"]
+        controls = os.path.join(run, "controls.bin")
+        z = read_controls(controls) if os.path.exists(controls) else None
+        for frame in range(frames + 1):
+            path = os.path.join(run, "export", f"frame_{frame:04d}.obj")
+            v, groups = read_obj(path)
+            if "cloth" not in groups or "body" not in groups:
+                raise SystemExit(f"{path}: no cloth or body group")
+            cloth_ids = sorted({i for tri in groups["cloth"] for i in tri})  # the particles, in order
+            x = [v[i] for i in cloth_ids]
+            bv, bt = v, groups["body"]
+            sd = signed_distances(x, bv, bt)
+            near = [(d, i) for i, (d, _) in enumerate(sd) if d is not None]
+            row = {"run": label, "frame": frame}
+            if near:
+                d, i = min(near)
+                row.update({"min_signed_distance_m": round(d, 5), "particle": i,
+                            "particles_inside": sum(1 for d, _ in near if d < 0)})
+                # The force over the frame that ends here (block f-1 acts from frame f-1 to f), along the inward normal.
+                if z is not None and frame >= 1 and len(z) == frames * 3 * len(x):
+                    o = (frame - 1) * 3 * len(x) + 3 * i
+                    u = z[o:o + 3]
+                    row["control_force_inward_N"] = round(-dot(u, sd[i][1]), 5)
+                    row["control_force_N"] = round(math.sqrt(dot(u, u)), 5)
+                # Lattice forces (per_frame_lattice, the last frames): the largest node force over the frame, the
+                # force each particle at that node gets (the lattice is spread bilinearly, not shared out).
+                elif z is not None and len(z) % 27 == 0 and frame > frames - len(z) // 27:
+                    o = (frame - 1 - (frames - len(z) // 27)) * 27
+                    nodes = [z[o + 3 * k:o + 3 * k + 3] for k in range(9)]
+                    u = max(nodes, key=lambda f: dot(f, f))
+                    row["lattice_max_node_N"] = round(math.sqrt(dot(u, u)), 5)
+                    row["lattice_max_node_up_N"] = round(u[1], 5)
+            rows.append(row)
+    fields = ["run", "frame", "min_signed_distance_m", "particle", "particles_inside", "control_force_inward_N",
+              "control_force_N", "lattice_max_node_N", "lattice_max_node_up_N"]
+    with open(out, "w") as f:
+        f.write(",".join(fields) + "\n")
+        for r in rows:
+            f.write(",".join(str(r.get(k, "")) for k in fields) + "\n")
+
+
+if __name__ == "__main__":
+    main()
