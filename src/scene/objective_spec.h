@@ -97,8 +97,10 @@ inline const char* control_kind_name(ControlKind k) {
 // The effort weight initial-velocity controls default to.
 constexpr double kInitialVelocityAlpha = 1e-6;
 
+// The defaults are the scene file's: a scene without controls.kind gets per_frame forces, what every shipped
+// scene asks for (tests/results/shots/README.md, "One default controls.kind"); the parser reads them here.
 struct ControlSpec {
-  ControlKind kind = ControlKind::kPerStep;
+  ControlKind kind = ControlKind::kPerFrame;
   double alpha = 1e-4;  // weight of the control effort ½α‖u‖² (forces' default; see kInitialVelocityAlpha)
   // Forces act from this frame on (per_step / per_frame); earlier steps are uncontrolled. A blend whose
   // start flails against the body is steered over its last frames, where the gradient stays finite.

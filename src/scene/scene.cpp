@@ -284,7 +284,7 @@ ControlSpec parse_controls(Block b, ControlsBlock where, int frames, const Contr
   // Initial velocities are one control per particle, summed in the effort: at forces' weight the effort of a
   // throw outweighs centimetres of keyframe error on a small sheet, so they get a smaller default.
   const bool initial = control_timing(c.kind) == ControlTiming::kInitial;
-  c.alpha = b.number("alpha", where == ControlsBlock::kForceStage ? c.alpha : initial ? kInitialVelocityAlpha : 1e-4,
+  c.alpha = b.number("alpha", where == ControlsBlock::kForceStage ? c.alpha : initial ? kInitialVelocityAlpha : ControlSpec{}.alpha,
                      0.0, 1e6);
   if (where != ControlsBlock::kInitialStage) c.from_frame = b.integer("from_frame", c.from_frame, 0, std::max(0, frames - 1));
   b.finish();
@@ -379,11 +379,7 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& file, Pa
   }
   if (root.has("character")) s.character = parse_character_spec(root.child("character"), s);
   for (Block& b : root.array("objectives")) s.objectives.push_back(parse_objective(std::move(b), s));
-  // A scene file without controls.kind gets per_frame forces, what every shipped scene asks for
-  // (tests/results/shots/README.md, "One default controls.kind").
-  ControlSpec scene_default;
-  scene_default.kind = ControlKind::kPerFrame;
-  s.controls = parse_controls(root.child("controls"), ControlsBlock::kScene, s.time.frames, scene_default);
+  s.controls = parse_controls(root.child("controls"), ControlsBlock::kScene, s.time.frames);
   s.optimizer = parse_optimizer(root.child("optimizer"), s.controls, s.time.frames);
   {
     Block b = root.child("render");

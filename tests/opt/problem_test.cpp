@@ -189,7 +189,9 @@ TEST(Problem, RemapBetweenWindowsKeepsEachFramesForce) {
 TEST(Problem, PlanarControlsHaveNoVerticalComponent) {
   TimeSpec t;
   t.frames = 3;
-  Controls c(ControlSpec{}, t, 5, true, VecX::Zero(15), VecX::Zero(15));
+  ControlSpec spec;
+  spec.kind = ControlKind::kPerStep;
+  Controls c(spec, t, 5, true, VecX::Zero(15), VecX::Zero(15));
   EXPECT_EQ(c.size(), 3 * 5 * 2);
   VecX v0;
   std::vector<VecX> U;
