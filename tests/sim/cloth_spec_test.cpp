@@ -67,7 +67,7 @@ TEST(ClothSpec, CollidersAndErrorsNameTheirPlace) {
   ASSERT_EQ(s.cloth->colliders.size(), 2u);
   EXPECT_EQ(std::get<TorusShape>(s.cloth->colliders[1].shape).axis, Vec3(0, 0, 1));
   EXPECT_STREQ(type_name(s.cloth->colliders[0]), "ground");
-  EXPECT_EQ(make_system(s)->describe(), "cloth: 16x16 particles, 1378 springs, 0 pinned, 2 colliders, PCG (incomplete_cholesky, tolerance 1e-08), exact adjoint");
+  EXPECT_EQ(make_system(s)->describe(), "cloth: 16x16 particles, 1378 springs, 0 pinned, 2 colliders (ground, torus), PCG (incomplete_cholesky, tolerance 1e-08), exact adjoint");
   EXPECT_EQ(scene_with(R"({"cg_preconditioner": "block_jacobi"})").cloth->cg_preconditioner, CgPreconditioner::kBlockJacobi);
   EXPECT_NE(error_of(R"({"cg_preconditioner": "ilu"})").find("/cloth/cg_preconditioner: expected one of"),
             std::string::npos);

@@ -9,6 +9,7 @@
 #include <tbb/partitioner.h>
 
 #include "core/error.h"
+#include "sim/cape/body_collider.h"
 #include "sim/cape/self_collider.h"
 #include "sim/cloth/imperfection.h"
 #include "sim/cloth/mesh_layout.h"
@@ -355,8 +356,22 @@ void ClothSystem::restore_step_context(int n, const VecX& context) { forward_sta
 std::string ClothSystem::describe() const {
   std::ostringstream os, tolerance;
   tolerance << spec_.cg_tolerance;
+  // Each collider by name, those the scene declared (by type) and those the system adds (a character's body,
+  // self contact), so a count never includes colliders the scene file does not show.
+  std::string names;
+  for (size_t k = 0; k < colliders_.size(); ++k) {
+    const Collider* c = colliders_[k].get();
+    const char* name = k < spec_.colliders.size()             ? type_name(spec_.colliders[k])
+                       : dynamic_cast<const SelfCollider*>(c) ? "self contact"
+                       : dynamic_cast<const BodyCollider*>(c) ? "body"
+                                                              : "added";
+    names += (names.empty() ? "" : ", ") + std::string(name);
+  }
+  const size_t nc = colliders_.size();
+  const std::string colliders =
+      nc == 0 ? "no colliders" : std::to_string(nc) + (nc == 1 ? " collider (" : " colliders (") + names + ")";
   os << "cloth: " << (spec_.mesh ? std::to_string(p_) + " mesh" : std::to_string(spec_.nx) + "x" + std::to_string(spec_.ny)) << " particles, " << assembly_.springs().list.size() << " springs, "
-     << pinned_list_.size() << " pinned, " << colliders_.size() << " colliders, "
+     << pinned_list_.size() << " pinned, " << colliders << ", "
      << (direct_solve_ ? std::string("sparse ") + FilteredDirect::backend() : std::string("PCG (") + preconditioner_name(spec_.mesh && !spec_.block_jacobi() ? Preconditioner::kIncompleteCholesky : preconditioner_kind(spec_.cg_preconditioner, p_)) + ", tolerance " + tolerance.str() + ")") << ", " << adjoint_name(adjoint_) << " adjoint";
   if (spec_.theta != 1) os << ", theta " << spec_.theta << " step";
   return os.str();
