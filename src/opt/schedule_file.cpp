@@ -55,7 +55,7 @@ void save_schedule(const fs::path& path, const StepSchedule& schedule, const Vec
     fs::remove(path, ec);
     return;
   }
-  ClothSystem::StepSchedule cut(std::size_t(steps));  // steps past a pattern's end decide afresh, as empty ones do
+  ClothSystem::StepSchedule cut(static_cast<std::size_t>(steps));  // steps past a pattern's end decide afresh, as empty ones do
   for (std::size_t n = 0; n < cut.size() && n < held->size(); ++n) cut[n] = (*held)[n];
   std::uint64_t depths = 0;
   for (const auto& p : cut) depths += p.size();
