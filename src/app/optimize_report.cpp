@@ -169,8 +169,8 @@ void diagnose_run(const Scene& scene, OptimizeRun& run, const EvaluationLog& elo
 }  // namespace
 
 // Simulates the best point (and, for a cape blend, the uncontrolled run its end state is measured
-// against), then writes controls.bin, trajectory.bin, meshes.bin, iterations.csv, convergence.png and
-// report.json into dir.
+// against), then writes controls.bin, schedule.bin, trajectory.bin, meshes.bin, iterations.csv, convergence.png
+// and report.json into dir.
 nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, bool resuming, OptimizeRun& run,
                                 const EvaluationLog& elog) {
   StrategyResult& job = run.strategy;

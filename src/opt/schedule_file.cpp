@@ -55,7 +55,8 @@ void save_schedule(const fs::path& path, const StepSchedule& schedule, const Vec
     fs::remove(path, ec);
     return;
   }
-  ClothSystem::StepSchedule cut(static_cast<std::size_t>(steps));  // steps past a pattern's end decide afresh, as empty ones do
+  // Steps past a pattern's end decide afresh, as empty ones do: padded or cut, it steps the same.
+  ClothSystem::StepSchedule cut(static_cast<std::size_t>(steps));
   for (std::size_t n = 0; n < cut.size() && n < held->size(); ++n) cut[n] = (*held)[n];
   std::uint64_t depths = 0;
   for (const auto& p : cut) depths += p.size();
@@ -80,14 +81,16 @@ StepSchedule load_schedule(const fs::path& path, const Scene& scene, const VecX&
   if (!in) refuse(path, "cannot be read");
   char magic[8];
   Header h;
-  if (!in.read(magic, 8) || std::memcmp(magic, kMagic, 8) != 0) refuse(path, "not a keyframe step schedule (bad magic)");
+  if (!in.read(magic, 8) || std::memcmp(magic, kMagic, 8) != 0)
+    refuse(path, "not a keyframe step schedule (bad magic)");
   if (!get(in, h.version) || !get(in, h.substeps) || !get(in, h.steps) || !get(in, h.fingerprint) || !get(in, h.depths))
     refuse(path, "truncated step schedule (header)");
   if (h.version != kVersion)
     refuse(path, "step schedule version " + std::to_string(h.version) + ", expected " + std::to_string(kVersion));
   // Sizes are checked against the file before anything is allocated for them.
   const std::uint64_t size = std::uint64_t(st.st_size);
-  if (h.depths > size || 4 * std::uint64_t(h.steps) > size || kHeaderBytes + 4 * std::uint64_t(h.steps) + h.depths != size)
+  if (h.depths > size || 4 * std::uint64_t(h.steps) > size ||
+      kHeaderBytes + 4 * std::uint64_t(h.steps) + h.depths != size)
     refuse(path, "truncated or oversized step schedule (" + std::to_string(h.steps) + " steps and " +
                      std::to_string(h.depths) + " substeps claimed in " + std::to_string(size) + " bytes)");
   if (!scene.cloth) refuse(path, "a step schedule, but the scene has no cloth to hold it");
@@ -120,7 +123,8 @@ StepSchedule run_schedule(const fs::path& dir, const Scene& scene, const VecX& z
   const fs::path file = dir / "schedule.bin";
   StepSchedule s = load_schedule(file, scene, z, substeps);
   if (s.empty() && scene.cloth && scene.optimizer.split_schedule == SplitSchedule::kHeld)
-    warn(printable(file.string()) + ": none stored (a run from before it was): the step schedule these controls "
+    warn(printable(file.string()) +
+         ": none stored (a run from before it was): the step schedule these controls "
          "are simulated under is chosen anew, and may not be the one the run's result was judged under");
   return s;
 }

@@ -151,8 +151,9 @@ TEST_F(ScheduleFile, RefusesTheScheduleOfOtherControlsOrAnotherStepLength) {
   try {
     load_schedule(file(), scene, other, scene.time.substeps);
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), name + "the step schedule of other controls than those beside it (remove it to "
-                                            "choose the schedule anew)");
+    EXPECT_EQ(std::string(e.what()), name +
+                                         "the step schedule of other controls than those beside it (remove it to "
+                                         "choose the schedule anew)");
   }
   Scene finer = scene;
   finer.time.substeps = 2;
