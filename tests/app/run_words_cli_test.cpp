@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
 
 #include "scene/scene.h"
 #include "../support/cli_test.h"
@@ -114,6 +115,32 @@ TEST_F(RunWordsCli, AFlockTargetOffTheGroundIsRefusedInOneLineWithNoRun) {
               "the ground and cannot reach y = 0.5)\n")
         << command;
     EXPECT_FALSE(fs::exists(dir_ / "run")) << command;
+  }
+}
+
+// A particle selector that matches nothing, in a keyframe and in the pins, or names a row the sheet does not
+// have, through the binary: exit 3, one line naming the file, the key's JSON pointer and the sheet's ranges,
+// and no run directory.
+TEST_F(RunWordsCli, ASelectorThatMatchesNothingIsRefusedInOneLineWithNoRun) {
+  auto scene = [](const std::string& selector, const std::string& pins) {
+    return R"({"time": {"frames": 4}, "cloth": {"nx": 5, "ny": 5, "width": 0.4, "height": 0.4)" + pins +
+           R"(}, "objectives": [{"type": "position", "frame": 2, "particles": )" + selector +
+           R"(, "targets": [[0, 1, 0]]}]})";
+  };
+  write("region.json", scene(R"({"u": [0.5, 0.6]})", ""));
+  write("pins.json", scene(R"({"row": 2})", R"(, "pins": {"i": [3, 4], "u": [0, 0.2]})"));
+  write("row.json", scene(R"({"row": 7})", ""));
+  const std::pair<const char*, const char*> cases[] = {
+      {"region", "keyframe: error: region.json: /objectives/0/particles: selects no particle of the 5 x 5 sheet "
+                 "({\"u\":[0.5,0.6]}; i runs 0 … 4, j 0 … 4, u 0 … 0.4 m, v 0 … 0.4 m)\n"},
+      {"pins", "keyframe: error: pins.json: /cloth/pins: selects no particle of the 5 x 5 sheet "
+               "({\"i\":[3,4],\"u\":[0,0.2]}; i runs 0 … 4, j 0 … 4, u 0 … 0.4 m, v 0 … 0.4 m)\n"},
+      {"row", "keyframe: error: row.json: /objectives/0/particles/row: expected an integer in [0, 4], got 7\n"}};
+  for (const auto& [name, message] : cases) {
+    const auto r = run_keyframe(std::string("simulate ") + name + ".json --out run", dir_);
+    EXPECT_EQ(r.code, 3) << r.output;
+    EXPECT_EQ(r.output, message);
+    EXPECT_FALSE(fs::exists(dir_ / "run")) << name;
   }
 }
 
