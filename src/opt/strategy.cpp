@@ -7,8 +7,6 @@
 #include <sstream>
 
 #include "core/error.h"
-#include "opt/budget_extension.h"
-#include "opt/diagnosis.h"
 #include "opt/friction_continuation.h"
 #include "opt/keyframe_projection.h"
 #include "opt/keyframe_weights.h"
@@ -41,7 +39,6 @@ struct Run {
   std::vector<double> friction_scales;  // per stage, on the scene's friction (StagePlan::friction_scales)
   std::vector<VecX> stage_ends;       // each stage's best controls as the scene's own (opt/uncontrolled_floor.h)
   int projected = 0;                  // a large sheet's evaluations spent in Gauss-Newton's passes (run_stage)
-  std::vector<double> last_phis;      // the last stage's objective at each evaluation (its rate of progress)
   StrategyResult r;
 };
 
@@ -359,8 +356,6 @@ void run_stage(Run& run, const std::vector<StageSpec>& stages, size_t s) {
   run.log.stage_finished();
   record_stage(run, res);
   run.stage_ends.push_back(as_scene_controls(run, res.z));
-  run.last_phis.clear();
-  for (const EvaluationRecord& e : res.history) run.last_phis.push_back(e.phi);
 }
 
 // Runs stages[first], stages[first + 1], ...: a stage that converged or stalled early leaves its unspent
@@ -532,43 +527,6 @@ void project_near_miss_at_end(Run& run) {
   problem.set_weight_scales(stage_weights);
 }
 
-// A run whose last stage stopped at the default budget with a keyframe near and still approaching: one more
-// stage of the same controls with the evaluations its rate says it needs (opt/budget_extension.h), appended to
-// `stages`. The run's status says what was decided. Gives whether it ran.
-bool extend_default_budget(Run& run, std::vector<StageSpec>& stages) {
-  StrategyResult& r = run.r;
-  if (!run.hooks.keyframes_unmet || !r.problem || !run.scene.cloth || r.interrupted || r.stages.empty() ||
-      run.from_controls || (run.stop && run.stop->load()))
-    return false;
-  BudgetExtensionFacts f;
-  f.stated = run.fixed_budgets || run.scene.optimizer.max_evaluations != OptimizerSpec{}.max_evaluations;
-  f.budget_stop = r.reason == StopReason::kEvaluationLimit;
-  if (f.stated || !f.budget_stop) return false;  // decided without a simulation: nothing else changes
-  Problem& problem = *r.problem;
-  problem.evaluate(r.z, nullptr);
-  if (problem.last_diverged()) return false;
-  f.met = !any_unmet(run.hooks.keyframes_unmet(problem));
-  f.worst_miss = near_miss_worst(problem, run.scene);
-  RunFacts rate;
-  rate.recent_improvement = recent_improvement(run.last_phis);
-  rate.evaluations = int(run.last_phis.size());
-  f.expected = expected_more_evaluations(rate, f.worst_miss);
-  f.budget = run.scene.optimizer.max_evaluations;
-  f.particle_steps = double(run.scene.cloth->particles()) * r.time.steps();
-  const BudgetExtension e = plan_budget_extension(BudgetExtensionRule{}, f);
-  if (!e.considered) return false;
-  run.log.say(e.why);
-  if (e.evaluations == 0) {
-    r.status += "; " + e.why;
-    return false;
-  }
-  run.all_evaluations += std::uint64_t(e.evaluations);
-  stages.push_back(StageSpec{r.time.substeps, e.evaluations, stages.back().controls});
-  run_stages(run, stages, stages.size() - 1);
-  r.status += " (" + e.why + ")";
-  return true;
-}
-
 // A run that ended in a window with forces held before it (interrupted, or its last stages skipped) gives
 // its result in the scene's own controls, the held forces included: what controls.bin, a resume and the
 // report read.
@@ -637,7 +595,6 @@ StrategyResult run_strategy(StrategySetup setup, const StrategyHooks& hooks, Str
   windows_after_early_end(run, stages);
   press_missed_keyframes(run, stages);
   project_near_miss_at_end(run);
-  if (extend_default_budget(run, stages)) project_near_miss_at_end(run);
   release_held_forces(run);
   r.weight_scales = run.weight_scales;
   if (r.problem) r.problem->set_weight_scales({});
