@@ -283,6 +283,19 @@ int expected_more_evaluations(const RunFacts& facts, double worst_miss) {
 
 namespace {
 
+// A budget stop whose cause is another (amplification, roughness, noise) still says what its own progress
+// expects of more evaluations: a user deciding whether to raise optimizer.max_evaluations needs that whatever
+// the cause.
+std::string budget_expectation(const RunFacts& facts, double worst_miss) {
+  const int more = expected_more_evaluations(facts, worst_miss);
+  const std::string over = format("the last tenth of its %.0f evaluations", facts.evaluations);
+  if (more > 0)
+    return "; at the rate the objective fell over " + over +
+           format(" (%.2gx), the worst keyframe needs about %.0f more evaluations to come within its tolerance",
+                  1 / std::max(facts.recent_improvement, 1e-300), double(more));
+  return "; the objective no longer fell over " + over + ", so more evaluations are not expected to reach it";
+}
+
 std::string budget_cause(const RunFacts& facts, double worst_miss) {
   std::string line = format("cause: its budget ended it after %.0f evaluations (the objective still fell %.2gx over "
                             "the last tenth of them",
@@ -294,7 +307,7 @@ std::string budget_cause(const RunFacts& facts, double worst_miss) {
 }
 
 // Noise at the start explains a run that stayed near it; one whose keyframe terms fell tenfold left it.
-std::string likely_cause(const Sensitivity& s, const RunFacts& facts, double worst_miss) {
+std::string likely_cause(const Sensitivity& s, const RunFacts& facts, double worst_miss, bool& budget_named) {
   if (every_trial_diverged(facts)) return diverged_cause(facts);
   if (unstable_edge(facts)) return unstable_cause(facts);
   if (s.noisy() && facts.keyframe_objective_end > 0.1 * facts.keyframe_objective_start)
@@ -306,8 +319,10 @@ std::string likely_cause(const Sensitivity& s, const RunFacts& facts, double wor
                           "break the symmetry (a small initial velocity or offset out of plane) or put the keyframe "
                           "later");
   if (s.amplifying()) return amplifying_cause(s, facts);
-  if (facts.budget && (facts.recent_improvement < 0.9 || facts.evaluations < kFewEvaluations))
+  if (facts.budget && (facts.recent_improvement < 0.9 || facts.evaluations < kFewEvaluations)) {
+    budget_named = true;
     return budget_cause(facts, worst_miss);
+  }
   if (facts.descent.rough()) {
     const DescentProbe& d = facts.descent;
     return "cause: where the optimiser stopped the objective is rough or stiff: along its descent direction it " +
@@ -343,8 +358,10 @@ Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensit
   }
   d.outcome = !d.progress ? "no_progress" : d.far ? "not_reached" : "near";
   const std::string untouched = untouched_cause(keyframes);
-  d.line = verdict_head(d, facts) + miss_text(*worst) + budget + "; " +
-           (untouched.empty() ? likely_cause(s, facts, worst->miss_after) : untouched);
+  bool budget_named = false;
+  const std::string cause = untouched.empty() ? likely_cause(s, facts, worst->miss_after, budget_named) : untouched;
+  d.line = verdict_head(d, facts) + miss_text(*worst) + budget + "; " + cause;
+  if (facts.budget && !budget_named && facts.evaluations > 0) d.line += budget_expectation(facts, worst->miss_after);
   if (!facts.fallback.empty()) d.line += "; " + facts.fallback;
   return d;
 }
