@@ -7,7 +7,6 @@
 #include <sstream>
 
 #include "core/error.h"
-#include "opt/budget_extension.h"
 #include "opt/friction_continuation.h"
 #include "opt/keyframe_projection.h"
 #include "opt/keyframe_weights.h"
@@ -528,68 +527,6 @@ void project_near_miss_at_end(Run& run) {
   problem.set_weight_scales(stage_weights);
 }
 
-// A near miss at the default budget whose effort holds its keyframe back: one more stage of the same controls
-// with the unmet keyframes' weights raised (opt/budget_extension.h), appended to `stages`, kept when it brings
-// the keyframe terms (at the scene's weights) down. The run's status says what was decided. Gives whether it ran.
-bool extend_default_budget(Run& run, std::vector<StageSpec>& stages) {
-  StrategyResult& r = run.r;
-  if (!run.hooks.keyframes_unmet || !r.problem || !run.scene.cloth || r.interrupted || r.stages.empty() ||
-      run.from_controls || run.scene.optimizer.soft_keyframes || (run.stop && run.stop->load()))
-    return false;
-  BudgetExtensionFacts f;
-  // A scene's max_evaluations is read as a number only: one stating the default is taken as not stating it.
-  f.stated = run.fixed_budgets || run.scene.optimizer.max_evaluations != OptimizerSpec{}.max_evaluations;
-  f.budget_stop = r.reason == StopReason::kEvaluationLimit;
-  if (f.stated || !f.budget_stop) return false;  // decided without a simulation: nothing else changes
-  Problem& problem = *r.problem;
-  const std::vector<double> stage_weights = problem.weight_scales();
-  problem.set_weight_scales({});  // the scene's weights
-  problem.evaluate(r.z, nullptr);
-  const std::optional<double> effort = last_effort(problem);
-  const double before = keyframe_terms_sum(problem);
-  const std::vector<bool> unmet = effort ? run.hooks.keyframes_unmet(problem) : std::vector<bool>{};
-  if (effort) f.worst_miss = near_miss_worst(problem, run.scene);
-  problem.set_weight_scales(stage_weights);
-  if (!effort) return false;  // diverged
-  f.met = !any_unmet(unmet);
-  f.effort_share = *effort / std::max(*effort + before, 1e-300);
-  f.budget = run.scene.optimizer.max_evaluations;
-  f.particle_steps = double(run.scene.cloth->particles()) * r.time.steps();
-  const BudgetExtension e = plan_budget_extension(BudgetExtensionRule{}, f);
-  if (!e.considered) return false;
-  run.log.say(e.why);
-  if (e.evaluations == 0) {
-    r.status += "; " + e.why;
-    return false;
-  }
-  const VecX z_before = r.z;
-  const StepSchedule schedule_before = r.schedule;
-  const std::vector<double> scales_before = run.weight_scales;
-  run.weight_scales = raised_weight_scales(run.weight_scales, unmet, KeyframeWeightRule{}, 1);
-  run.all_evaluations += std::uint64_t(e.evaluations);
-  stages.push_back(StageSpec{r.time.substeps, e.evaluations, stages.back().controls});
-  run_stages(run, stages, stages.size() - 1);
-  r.status += " (" + e.why + ")";
-  if (r.interrupted) return true;
-  Problem& after_problem = *r.problem;
-  const std::vector<double> after_weights = after_problem.weight_scales();
-  after_problem.set_weight_scales({});
-  after_problem.evaluate(r.z, nullptr);
-  const double after = last_effort(after_problem) ? keyframe_terms_sum(after_problem) : INFINITY;
-  after_problem.set_weight_scales(after_weights);
-  if (after < before) return true;
-  std::ostringstream os;
-  os << std::scientific << std::setprecision(3) << "the extension took the keyframe terms from " << before << " to "
-     << after << ": the point before it is kept";
-  run.log.say(os.str());
-  r.status += "; " + os.str();
-  r.z = z_before;
-  r.schedule = schedule_before;
-  run.weight_scales = scales_before;
-  if (r.hold_splits) r.sys->hold_step_schedule(r.schedule);
-  return true;
-}
-
 // A run that ended in a window with forces held before it (interrupted, or its last stages skipped) gives
 // its result in the scene's own controls, the held forces included: what controls.bin, a resume and the
 // report read.
@@ -658,7 +595,6 @@ StrategyResult run_strategy(StrategySetup setup, const StrategyHooks& hooks, Str
   windows_after_early_end(run, stages);
   press_missed_keyframes(run, stages);
   project_near_miss_at_end(run);
-  if (extend_default_budget(run, stages)) project_near_miss_at_end(run);
   release_held_forces(run);
   r.weight_scales = run.weight_scales;
   if (r.problem) r.problem->set_weight_scales({});
