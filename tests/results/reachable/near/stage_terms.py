@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Each stage's best evaluation in a run's log.txt: its evaluations, stop (from report.json), objective and
-keyframe terms (at the stage's weights), and how much the best objective fell over the stage's last tenth.
+gradient norm, keyframe terms (at the stage's weights) and effort, and how much the best objective fell over the stage's last tenth.
 
 Usage: stage_terms.py RUN_DIR...   (run directories of `keyframe optimize`)"""
 import json, re, sys
@@ -8,7 +8,7 @@ import json, re, sys
 for d in sys.argv[1:]:
     stages, order = {}, []
     for line in open(d + "/log.txt"):
-        m = re.match(r"(?:stage (\d+) )?eval\s+\d+\s+phi (\S+)\s+\|g\| \S+\s+(.*?effort \S+)", line)
+        m = re.match(r"(?:stage (\d+) )?eval\s+\d+\s+phi (\S+)\s+(\|g\| \S+\s+.*?effort \S+)", line)
         if not m:
             continue
         s = m.group(1) or "1"
