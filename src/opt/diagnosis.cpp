@@ -293,17 +293,26 @@ std::string budget_expectation(const RunFacts& facts, double worst_miss) {
     return "; at the rate the objective fell over " + over +
            format(" (%.2gx), the worst keyframe needs about %.0f more evaluations to come within its tolerance",
                   1 / std::max(facts.recent_improvement, 1e-300), double(more));
+  if (facts.evaluations < kFewEvaluations)
+    return "; the objective did not fall over " + over + ", too few evaluations to tell how many more it needs";
   return "; the objective no longer fell over " + over + ", so more evaluations are not expected to reach it";
 }
 
 std::string budget_cause(const RunFacts& facts, double worst_miss) {
-  std::string line = format("cause: its budget ended it after %.0f evaluations (the objective still fell %.2gx over "
-                            "the last tenth of them",
-                            facts.evaluations, 1 / std::max(facts.recent_improvement, 1e-300));
   const int more = expected_more_evaluations(facts, worst_miss);
-  if (more > 0)
-    line += format("; at that rate the worst keyframe needs about %.0f more to come within its tolerance", double(more));
-  return line + "); change: raise optimizer.max_evaluations";
+  // Named for a small budget whatever its rate: a run of a few evaluations that did not fall over its last
+  // tenth (one or two line-search trials) says nothing of how many more it needs.
+  if (more == 0)
+    return format("cause: its budget ended it after %.0f evaluations (the objective did not fall over the last "
+                  "tenth of them, too few evaluations to tell how many more it needs); change: raise "
+                  "optimizer.max_evaluations",
+                  facts.evaluations);
+  return format("cause: its budget ended it after %.0f evaluations (the objective still fell %.2gx over the last "
+                "tenth of them",
+                facts.evaluations, 1 / std::max(facts.recent_improvement, 1e-300)) +
+         format("; at that rate the worst keyframe needs about %.0f more to come within its tolerance); change: "
+                "raise optimizer.max_evaluations",
+                double(more));
 }
 
 // Noise at the start explains a run that stayed near it; one whose keyframe terms fell tenfold left it.

@@ -70,6 +70,27 @@ TEST(DiagnosisBudget, ARunAtItsBudgetNoLongerFallingSaysMoreAreNotExpectedToReac
   EXPECT_EQ(line.find("needs about"), std::string::npos) << line;
 }
 
+// A few evaluations that did not fall over their last tenth (a line search's trials) say nothing of how many
+// more the run needs, whichever cause is named.
+TEST(DiagnosisBudget, AFewEvaluationsThatDidNotFallAreTooFewToTell) {
+  RunFacts few = at_budget(1.0);
+  few.evaluations = 15;
+  const std::string amplified = diagnose(missed_by(2.2), amplifying(), few).line;
+  EXPECT_NE(amplified.find("did not fall over the last tenth of its 15 evaluations, too few evaluations to tell how "
+                           "many more it needs"),
+            std::string::npos)
+      << amplified;
+  EXPECT_EQ(amplified.find("not expected to reach it"), std::string::npos) << amplified;
+  Sensitivity smooth;
+  smooth.growth = smooth.growth_beyond_free = 1.5;
+  const std::string budget = diagnose(missed_by(2.2), smooth, few).line;
+  EXPECT_NE(budget.find("cause: its budget ended it after 15 evaluations (the objective did not fall over the last "
+                        "tenth of them, too few evaluations to tell how many more it needs)"),
+            std::string::npos)
+      << budget;
+  EXPECT_EQ(budget.find("still fell 1x"), std::string::npos) << budget;
+}
+
 // Said once: where the budget is the cause named, its own sentence has the estimate.
 TEST(DiagnosisBudget, TheEstimateIsSaidOnceAndOnlyForABudgetStop) {
   Sensitivity smooth;
