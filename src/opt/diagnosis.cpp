@@ -285,7 +285,9 @@ namespace {
 
 // A budget stop whose cause is another (amplification, roughness, noise) still says what its own progress
 // expects of more evaluations: a user deciding whether to raise optimizer.max_evaluations needs that whatever
-// the cause.
+// the cause. Nothing when the best objective did not fall over the last tenth: that tenth may begin in a stage
+// whose objective is not comparable (raised keyframe weights, another control kind's effort), so it says
+// nothing of the last stage's own progress.
 std::string budget_expectation(const RunFacts& facts, double worst_miss) {
   const int more = expected_more_evaluations(facts, worst_miss);
   const std::string over = format("the last tenth of its %.0f evaluations", facts.evaluations);
@@ -295,7 +297,7 @@ std::string budget_expectation(const RunFacts& facts, double worst_miss) {
                   1 / std::max(facts.recent_improvement, 1e-300), double(more));
   if (facts.evaluations < kFewEvaluations)
     return "; the objective did not fall over " + over + ", too few evaluations to tell how many more it needs";
-  return "; the objective no longer fell over " + over + ", so more evaluations are not expected to reach it";
+  return {};
 }
 
 std::string budget_cause(const RunFacts& facts, double worst_miss) {

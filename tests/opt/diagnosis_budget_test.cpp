@@ -1,6 +1,6 @@
 // A run stopped at its budget says what more evaluations are expected to bring, whatever cause the diagnosis
-// names (opt/diagnosis.h): the near misses of the generated suite stop at their budget in motion that
-// amplifies perturbations, and their diagnoses named only the amplification.
+// names (opt/diagnosis.h), when its progress says anything: the near misses of the generated suite stop at
+// their budget in motion that amplifies perturbations, and their diagnoses named only the amplification.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -61,13 +61,15 @@ TEST(DiagnosisBudget, AnAmplifyingRunAtItsBudgetStatesTheEvaluationsItExpectsToN
       << line;
 }
 
-TEST(DiagnosisBudget, ARunAtItsBudgetNoLongerFallingSaysMoreAreNotExpectedToReachIt) {
-  const std::string line = diagnose(missed_by(1.15), amplifying(), at_budget(1.0)).line;
-  EXPECT_NE(line.find("no longer fell over the last tenth of its 300 evaluations, so more evaluations are not "
-                      "expected to reach it"),
-            std::string::npos)
-      << line;
+// The whole run's last tenth may begin in an earlier stage whose objective is lower only because its weights or
+// control kind differ (throw-0: its lattice stage's 3.5e-4 against its per-particle stage's 1.15e-3): a best
+// objective that did not fall over it says nothing of the last stage's progress, and the line adds nothing.
+TEST(DiagnosisBudget, ARunAtItsBudgetWhoseBestDidNotFallAddsNoEstimate) {
+  const std::string line = diagnose(missed_by(1.24), amplifying(), at_budget(1.0)).line;
+  EXPECT_NE(line.find("it stopped at its budget"), std::string::npos) << line;
   EXPECT_EQ(line.find("needs about"), std::string::npos) << line;
+  EXPECT_EQ(line.find("not expected"), std::string::npos) << line;
+  EXPECT_EQ(line.find("too few"), std::string::npos) << line;
 }
 
 // A few evaluations that did not fall over their last tenth (a line search's trials) say nothing of how many
