@@ -12,6 +12,7 @@
 #include "core/warnings.h"
 #include "opt/controls_file.h"
 #include "opt/gradcheck.h"
+#include "opt/schedule_file.h"
 #include "scene/scene.h"
 #include "sim/make_system.h"
 
@@ -79,6 +80,8 @@ void run_gradcheck(const GradcheckCommandOptions& o) {
       throw InputError(o.at + "/controls.bin: holds " + std::to_string(z.size()) + " controls at " +
                        std::to_string(substeps) + " substeps; the scene's controls are " +
                        std::to_string(problem.size()) + " at " + std::to_string(scene.time.substeps));
+    // The run's own objective: its controls under the step schedule its result was judged under.
+    if (const StepSchedule s = run_schedule(o.at, scene, z, substeps); !s.empty()) sys->hold_step_schedule(s);
   } else {
     std::mt19937_64 rng(o.seed);
     std::normal_distribution<double> normal(0.0, o.perturb);
@@ -126,7 +129,8 @@ void add_gradcheck_options(CLI::App* sub, const std::shared_ptr<GradcheckCommand
   sub->add_option("--perturb", o->perturb, "scale of the random controls the check is made at (0: the scene's initial guess)")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
-  sub->add_option("--at", o->at, "check at a run's controls (RUN_DIR/controls.bin) instead of perturbed ones")
+  sub->add_option("--at", o->at, "check at a run's controls (RUN_DIR/controls.bin, under the step schedule its result was "
+                                  "judged under, RUN_DIR/schedule.bin) instead of perturbed ones")
       ->excludes(sub->get_option("--perturb"));
   sub->add_option("--line", o->line, "also print φ at this many log-spaced steps along the negative gradient")
       ->check(CLI::Range(0, 1000));

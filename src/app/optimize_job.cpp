@@ -18,6 +18,7 @@
 #include "core/warnings.h"
 #include "opt/controls_file.h"
 #include "opt/evaluation_tape.h"
+#include "opt/schedule_file.h"
 #include "opt/strategy.h"
 #include "opt/windows.h"
 #include "opt/keyframes/keyframe_reach.h"
@@ -124,13 +125,15 @@ StrategyHooks job_hooks(const Scene& scene, const OptimizeOptions& opt, std::uin
 }
 
 // A run that kept its evaluations resumes by replaying them from the start (the same path, budget and
-// result as if it had not stopped); an older one continues its last stage from controls.bin.
+// result as if it had not stopped); an older one continues its last stage from controls.bin, under the step
+// schedule its result was judged under (schedule.bin), from the objective the run ended at.
 void prepare_resume(const fs::path& dir, StrategySetup& setup) {
   if (fs::exists(dir / "evaluations.bin")) {
     setup.tape.set_replay(load_evaluations(dir / "evaluations.bin"), dir / "evaluations.bin");
     return;
   }
   setup.start = load_controls(dir / "controls.bin", &setup.start_time.substeps);
+  setup.start_schedule = run_schedule(dir, setup.scene, setup.start, setup.start_time.substeps);
   setup.plan.stages.erase(setup.plan.stages.begin(), setup.plan.stages.end() - 1);
 }
 

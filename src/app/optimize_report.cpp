@@ -12,6 +12,7 @@
 #include "core/atomic_file.h"
 #include "core/trajectory.h"
 #include "opt/controls_file.h"
+#include "opt/schedule_file.h"
 #include "opt/term_breakdown.h"
 #include "report/cape_end_state.h"
 #include "report/figure_measures.h"
@@ -82,10 +83,13 @@ UncontrolledRun run_uncontrolled(const Scene& scene, StrategyResult& job) {
   return u;
 }
 
-// controls.bin, evaluations.bin (when kept), trajectory.bin, meshes.bin, iterations.csv and convergence.png.
+// controls.bin, schedule.bin (the step schedule the result was judged under, when the run held one),
+// evaluations.bin (when kept), trajectory.bin, meshes.bin, iterations.csv and convergence.png.
 void write_run_files(const fs::path& dir, const Scene& scene, const StrategyResult& job, const Trajectory& frames,
                      const EvaluationLog& elog) {
   save_controls(dir / "controls.bin", job.z, job.time.substeps);
+  save_schedule(dir / "schedule.bin", job.hold_splits ? job.schedule : StepSchedule{}, job.z, job.time.substeps,
+                job.time.steps());
   std::error_code ec;
   if (job.tape.complete()) save_evaluations(dir / "evaluations.bin", job.tape.contents());
   else fs::remove(dir / "evaluations.bin", ec);  // too large to keep: a resume restarts from controls.bin
@@ -165,8 +169,8 @@ void diagnose_run(const Scene& scene, OptimizeRun& run, const EvaluationLog& elo
 }  // namespace
 
 // Simulates the best point (and, for a cape blend, the uncontrolled run its end state is measured
-// against), then writes controls.bin, trajectory.bin, meshes.bin, iterations.csv, convergence.png and
-// report.json into dir.
+// against), then writes controls.bin, schedule.bin, trajectory.bin, meshes.bin, iterations.csv, convergence.png
+// and report.json into dir.
 nlohmann::json write_run_report(const fs::path& dir, const Scene& scene, bool resuming, OptimizeRun& run,
                                 const EvaluationLog& elog) {
   StrategyResult& job = run.strategy;

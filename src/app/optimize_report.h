@@ -1,6 +1,6 @@
 #pragma once
-// What `optimize` writes after its strategy ran: controls.bin, evaluations.bin, trajectory.bin, meshes.bin,
-// iterations.csv, convergence.png and report.json, with the diagnosis (opt/diagnosis.h) of whether the
+// What `optimize` writes after its strategy ran: controls.bin, schedule.bin, evaluations.bin, trajectory.bin,
+// meshes.bin, iterations.csv, convergence.png and report.json, with the diagnosis (opt/diagnosis.h) of whether the
 // keyframes were reached; and the keyframe judgement the strategy's stop rule asks.
 #include <filesystem>
 

@@ -591,6 +591,7 @@ StrategyResult run_strategy(StrategySetup setup, const StrategyHooks& hooks, Str
   r.time.substeps = stages[0].substeps;
   r.sys = std::move(setup.system);
   r.hold_splits = scene.cloth && scene.optimizer.split_schedule == SplitSchedule::kHeld;
+  if (r.hold_splits) r.schedule = std::move(setup.start_schedule);  // a resume's first stage goes on under it
   run_stages(run, stages, 0);
   windows_after_early_end(run, stages);
   press_missed_keyframes(run, stages);

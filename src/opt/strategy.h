@@ -72,6 +72,7 @@ struct StrategySetup {
   // initial guess (or the throw search's best).
   VecX start;
   TimeSpec start_time;
+  StepSchedule start_schedule;          // the step schedule `start` was judged under (schedule.bin); empty: chosen anew
   std::filesystem::path controls_file;  // named in messages about the controls
   std::unique_ptr<System> system;       // the first stage's
   EvaluationTape tape;                  // what it replays (a resume), and where every evaluation is recorded

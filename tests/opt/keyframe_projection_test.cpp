@@ -16,6 +16,7 @@
 #include "opt/keyframe_residuals.h"
 #include "opt/keyframes/keyframe_common.h"
 #include "opt/problem.h"
+#include "opt/schedule_file.h"
 #include "scene/scene.h"
 #include "sim/make_system.h"
 #include "residual_flight_check.h"
@@ -172,12 +173,13 @@ TEST(KeyframeProjection, DISABLED_FromARunsResult) {
   const std::filesystem::path run(dir);
   const Scene scene = load_scene(run / "scene.json");
   const VecX z = load_controls(run / "controls.bin");
+  const StepSchedule held = run_schedule(run, scene, z, scene.time.substeps);  // the run's (older runs: z's own)
   for (bool smooth : {true, false})
     for (bool unmet_only : {false, true}) {
       auto sys = make_system(scene);
       Problem problem(scene, scene.time, *sys);
       problem.evaluate(z, nullptr);
-      sys->hold_step_schedule(sys->step_schedule());
+      sys->hold_step_schedule(held.empty() ? sys->step_schedule() : held);
       if (unmet_only) {
         std::vector<double> scales;
         for (const auto& term : problem.breakdown())

@@ -17,6 +17,7 @@
 #include "opt/problem.h"
 #include "opt/projection_metric.h"
 #include "opt/residual_sketch.h"
+#include "opt/schedule_file.h"
 #include "scene/scene.h"
 #include "sim/make_system.h"
 
@@ -32,8 +33,9 @@ TEST(NearMissWhy, DISABLED_AtARunsResult) {
   auto sys = make_system(scene);
   Problem problem(scene, scene.time, *sys);
   ASSERT_EQ(z.size(), problem.size());
+  const StepSchedule held = run_schedule(run, scene, z, scene.time.substeps);  // the run's (older runs: z's own)
   problem.evaluate(z, nullptr);
-  sys->hold_step_schedule(sys->step_schedule());
+  sys->hold_step_schedule(held.empty() ? sys->step_schedule() : held);
   ResidualFlight flight(problem, placed_keyframes(problem, scene));
   ASSERT_TRUE(flight.fly(z));
   const VecX r = flight.residuals();

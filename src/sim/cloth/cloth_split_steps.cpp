@@ -3,26 +3,17 @@
 // schedule (sim/system.h), which the optimisation strategy holds so a line search meets no jump where the
 // energy check would flip between trial points.
 #include "sim/cloth/cloth_system.h"
+#include "sim/cloth/cloth_split_pattern.h"
 
 #include <cmath>
 
 namespace kf {
 
-namespace {
-struct ClothSplitPattern final : StepSchedule::Pattern {
-  explicit ClothSplitPattern(ClothSystem::StepSchedule s) : steps_(std::move(s)) {}
-  int steps() const override { return int(steps_.size()); }
-  ClothSystem::StepSchedule steps_;
-};
-}  // namespace
-
-kf::StepSchedule ClothSystem::step_schedule() const {
-  return kf::StepSchedule(std::make_shared<const ClothSplitPattern>(recorded_));
-}
+kf::StepSchedule ClothSystem::step_schedule() const { return cloth_split_schedule(recorded_); }
 
 void ClothSystem::hold_step_schedule(const kf::StepSchedule& schedule) {
-  const auto* p = dynamic_cast<const ClothSplitPattern*>(schedule.pattern());
-  hold_schedule(p ? p->steps_ : StepSchedule{});
+  const StepSchedule* steps = cloth_split_steps(schedule);
+  hold_schedule(steps ? *steps : StepSchedule{});
 }
 
 void ClothSystem::record_pattern(int n, bool ok, const ClothRecord& rec) {
