@@ -283,18 +283,42 @@ int expected_more_evaluations(const RunFacts& facts, double worst_miss) {
 
 namespace {
 
-std::string budget_cause(const RunFacts& facts, double worst_miss) {
-  std::string line = format("cause: its budget ended it after %.0f evaluations (the objective still fell %.2gx over "
-                            "the last tenth of them",
-                            facts.evaluations, 1 / std::max(facts.recent_improvement, 1e-300));
+// A budget stop whose cause is another (amplification, roughness, noise) still says what its own progress
+// expects of more evaluations: a user deciding whether to raise optimizer.max_evaluations needs that whatever
+// the cause. Nothing when the best objective did not fall over the last tenth: that tenth may begin in a stage
+// whose objective is not comparable (raised keyframe weights, another control kind's effort), so it says
+// nothing of the last stage's own progress.
+std::string budget_expectation(const RunFacts& facts, double worst_miss) {
   const int more = expected_more_evaluations(facts, worst_miss);
+  const std::string over = format("the last tenth of its %.0f evaluations", facts.evaluations);
   if (more > 0)
-    line += format("; at that rate the worst keyframe needs about %.0f more to come within its tolerance", double(more));
-  return line + "); change: raise optimizer.max_evaluations";
+    return "; at the rate the objective fell over " + over +
+           format(" (%.2gx), the worst keyframe needs about %.0f more evaluations to come within its tolerance",
+                  1 / std::max(facts.recent_improvement, 1e-300), double(more));
+  if (facts.evaluations < kFewEvaluations)
+    return "; the objective did not fall over " + over + ", too few evaluations to tell how many more it needs";
+  return {};
+}
+
+std::string budget_cause(const RunFacts& facts, double worst_miss) {
+  const int more = expected_more_evaluations(facts, worst_miss);
+  // Named for a small budget whatever its rate: a run of a few evaluations that did not fall over its last
+  // tenth (one or two line-search trials) says nothing of how many more it needs.
+  if (more == 0)
+    return format("cause: its budget ended it after %.0f evaluations (the objective did not fall over the last "
+                  "tenth of them, too few evaluations to tell how many more it needs); change: raise "
+                  "optimizer.max_evaluations",
+                  facts.evaluations);
+  return format("cause: its budget ended it after %.0f evaluations (the objective still fell %.2gx over the last "
+                "tenth of them",
+                facts.evaluations, 1 / std::max(facts.recent_improvement, 1e-300)) +
+         format("; at that rate the worst keyframe needs about %.0f more to come within its tolerance); change: "
+                "raise optimizer.max_evaluations",
+                double(more));
 }
 
 // Noise at the start explains a run that stayed near it; one whose keyframe terms fell tenfold left it.
-std::string likely_cause(const Sensitivity& s, const RunFacts& facts, double worst_miss) {
+std::string likely_cause(const Sensitivity& s, const RunFacts& facts, double worst_miss, bool& budget_named) {
   if (every_trial_diverged(facts)) return diverged_cause(facts);
   if (unstable_edge(facts)) return unstable_cause(facts);
   if (s.noisy() && facts.keyframe_objective_end > 0.1 * facts.keyframe_objective_start)
@@ -306,8 +330,10 @@ std::string likely_cause(const Sensitivity& s, const RunFacts& facts, double wor
                           "break the symmetry (a small initial velocity or offset out of plane) or put the keyframe "
                           "later");
   if (s.amplifying()) return amplifying_cause(s, facts);
-  if (facts.budget && (facts.recent_improvement < 0.9 || facts.evaluations < kFewEvaluations))
+  if (facts.budget && (facts.recent_improvement < 0.9 || facts.evaluations < kFewEvaluations)) {
+    budget_named = true;
     return budget_cause(facts, worst_miss);
+  }
   if (facts.descent.rough()) {
     const DescentProbe& d = facts.descent;
     return "cause: where the optimiser stopped the objective is rough or stiff: along its descent direction it " +
@@ -343,8 +369,10 @@ Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensit
   }
   d.outcome = !d.progress ? "no_progress" : d.far ? "not_reached" : "near";
   const std::string untouched = untouched_cause(keyframes);
-  d.line = verdict_head(d, facts) + miss_text(*worst) + budget + "; " +
-           (untouched.empty() ? likely_cause(s, facts, worst->miss_after) : untouched);
+  bool budget_named = false;
+  const std::string cause = untouched.empty() ? likely_cause(s, facts, worst->miss_after, budget_named) : untouched;
+  d.line = verdict_head(d, facts) + miss_text(*worst) + budget + "; " + cause;
+  if (facts.budget && !budget_named && facts.evaluations > 0) d.line += budget_expectation(facts, worst->miss_after);
   if (!facts.fallback.empty()) d.line += "; " + facts.fallback;
   return d;
 }

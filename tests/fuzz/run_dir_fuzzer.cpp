@@ -1,6 +1,6 @@
 // libFuzzer target for the files keyframe reads back from a run directory and a sweep directory: the first
 // byte picks the file (trajectory.bin, controls.bin, scene_name.txt, report.json, sweep.json,
-// evaluations.bin), the rest is its contents. Every input either reads or raises InputError; a crash, a hang or another exception is a
+// evaluations.bin, schedule.bin), the rest is its contents. Every input either reads or raises InputError; a crash, a hang or another exception is a
 // finding.
 #include <unistd.h>
 
@@ -15,6 +15,7 @@
 #include "farm/run_report.h"
 #include "opt/controls_file.h"
 #include "opt/evaluation_tape.h"
+#include "opt/schedule_file.h"
 #include "scene/run_name.h"
 
 namespace {
@@ -32,11 +33,21 @@ const fs::path& scratch() {
 void write_file(const fs::path& p, const uint8_t* data, size_t size) {
   std::ofstream(p, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(data), std::streamsize(size));
 }
+
+// A cloth scene whose runs hold their split pattern: what a schedule.bin is read against.
+const kf::Scene& cloth_scene() {
+  static const kf::Scene scene = [] {
+    kf::Scene s;
+    s.cloth = kf::ClothSpec{};
+    return s;
+  }();
+  return scene;
+}
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;
-  const int which = data[0] % 6;
+  const int which = data[0] % 7;
   const fs::path& dir = scratch();
   try {
     switch (which) {
@@ -59,6 +70,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       case 4:
         write_file(dir / "sweep.json", data + 1, size - 1);
         (void)kf::farm::read_sweep_manifest(dir);
+        break;
+      case 5:
+        write_file(dir / "schedule.bin", data + 1, size - 1);
+        (void)kf::load_schedule(dir / "schedule.bin", cloth_scene(), kf::VecX::Zero(4), cloth_scene().time.substeps);
         break;
       default:
         write_file(dir / "evaluations.bin", data + 1, size - 1);

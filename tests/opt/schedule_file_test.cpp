@@ -20,30 +20,14 @@
 #include "scene/scene.h"
 #include "sim/cloth/cloth_split_pattern.h"
 #include "sim/make_system.h"
+#include "../sim/split_curtain.h"
 
 namespace kf {
 namespace {
 namespace fs = std::filesystem;
 
-// A curtain pinned along one edge and released flat: the energy check splits most of its steps at one step per
-// frame (tests/sim/cloth_held_schedule_test.cpp).
-Scene curtain() {
-  return parse_scene(R"({
-    "time": {"fps": 30, "frames": 12},
-    "cloth": {"nx": 8, "ny": 6, "width": 0.8, "height": 0.5, "mass": 0.2,
-              "origin": [-0.4, 1.5, 0.5], "u_axis": [1, 0, 0], "v_axis": [0, 0, -1], "pins": "top_edge"},
-    "objectives": [{"type": "center_of_mass", "frame": 12, "particles": [40, 41, 42, 43, 44, 45, 46, 47],
-                    "target": [0, 1.1, -0.1]}],
-    "controls": {"kind": "per_frame", "alpha": 1e-4}
-  })",
-                     "curtain.json");
-}
-
-int split_steps(const ClothSystem::StepSchedule& s) {
-  int n = 0;
-  for (const auto& pattern : s) n += pattern.size() > 1;
-  return n;
-}
+// The curtain of tests/sim/split_curtain.h, its free edge keyframed.
+Scene curtain() { return test::split_curtain("", "[40, 41, 42, 43, 44, 45, 46, 47]"); }
 
 std::string read_bytes(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -91,7 +75,7 @@ class ScheduleFile : public ::testing::Test {
 TEST_F(ScheduleFile, LoadsThePatternItWasSavedFromAndReplaysItBitForBit) {
   const ClothSystem::StepSchedule* saved = cloth_split_steps(schedule);
   ASSERT_NE(saved, nullptr);
-  ASSERT_GT(split_steps(*saved), 2) << "the curtain should need split steps";
+  ASSERT_GT(test::split_steps(*saved), 2) << "the curtain should need split steps";
   const StepSchedule loaded = load_schedule(file(), scene, z, scene.time.substeps);
   ASSERT_NE(cloth_split_steps(loaded), nullptr);
   EXPECT_EQ(*cloth_split_steps(loaded), *saved);

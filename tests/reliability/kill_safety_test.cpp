@@ -56,6 +56,10 @@ void expect_file_valid(const fs::path& file) {
     uint64_t n = 0;
     std::memcpy(&n, b.data() + 8, 8);
     EXPECT_EQ(b.size(), 20 + 8 * n);  // header: magic, count, substeps (opt/controls_file.h)
+  } else if (name == "schedule.bin") {  // read against its scene and controls by the resume tests
+    const std::string b = read_text(file);
+    ASSERT_GE(b.size(), 8u);
+    EXPECT_EQ(b.substr(0, 8), "KFSCHEDL");
   } else if (name == "evaluations.bin") {
     EXPECT_NO_THROW({ auto e = load_evaluations(file); (void)e; });
   } else if (ext == ".png") {
@@ -83,7 +87,7 @@ std::set<std::string> expect_run_dir_valid(const fs::path& run, const std::strin
   static const std::set<std::string> kKnown = {"scene.json",     "scene_name.txt", "controls.bin",
                                                "trajectory.bin", "iterations.csv", "convergence.png",
                                                "report.json",    "log.txt",        "frames",
-                                               "evaluations.bin"};
+                                               "evaluations.bin", "schedule.bin"};
   std::set<std::string> seen;
   if (!fs::exists(run)) return seen;
   for (const auto& e : fs::recursive_directory_iterator(run)) {

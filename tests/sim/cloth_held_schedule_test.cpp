@@ -10,30 +10,14 @@
 #include "scene/scene.h"
 #include "sim/cloth/cloth_system.h"
 #include "sim/make_system.h"
+#include "split_curtain.h"
 
 namespace kf {
 namespace {
 
-// A small curtain pinned along one edge and released flat: it swings down fast, and the energy check
-// splits most of its steps at one step per frame. Solved to 1e-13: at the default PCG tolerance (1e-8) the
-// solves' own error shows in the gradient at about 3e-5.
-Scene curtain() {
-  return parse_scene(R"({
-    "time": {"fps": 30, "frames": 12},
-    "cloth": {"nx": 8, "ny": 6, "width": 0.8, "height": 0.5, "mass": 0.2,
-              "origin": [-0.4, 1.5, 0.5], "u_axis": [1, 0, 0], "v_axis": [0, 0, -1], "pins": "top_edge", "cg_tolerance": 1e-13},
-    "objectives": [{"type": "center_of_mass", "frame": 12, "particles": [0, 1, 2, 3, 4, 5, 6, 7],
-                    "target": [0, 1.1, -0.1]}],
-    "controls": {"kind": "per_frame", "alpha": 1e-4}
-  })",
-                     "curtain.json");
-}
-
-int split_steps(const ClothSystem::StepSchedule& s) {
-  int n = 0;
-  for (const auto& pattern : s) n += pattern.size() > 1;
-  return n;
-}
+// The curtain of split_curtain.h, solved to 1e-13: at the default PCG tolerance (1e-8) the solves' own error
+// shows in the gradient at about 3e-5.
+Scene curtain() { return test::split_curtain(R"(, "cg_tolerance": 1e-13)", "[0, 1, 2, 3, 4, 5, 6, 7]"); }
 
 // The curtain's system and problem, simulated once, adaptively, under random forces of about the
 // particles' weight: a perturbed control, not the start.
@@ -56,7 +40,7 @@ class ClothHeldSchedule : public ::testing::Test {
 TEST_F(ClothHeldSchedule, RepeatsTheRunThatRecordedIt) {
   const ClothSystem::StepSchedule recorded = cloth.schedule();
   ASSERT_EQ(int(recorded.size()), scene.time.steps());
-  ASSERT_GT(split_steps(recorded), 2) << "the curtain should need split steps";
+  ASSERT_GT(test::split_steps(recorded), 2) << "the curtain should need split steps";
   cloth.hold_schedule(recorded);
   EXPECT_EQ(problem.evaluate(z, nullptr), adaptive);
   EXPECT_EQ(problem.rollout().x.back(), adaptive_end);
@@ -64,7 +48,7 @@ TEST_F(ClothHeldSchedule, RepeatsTheRunThatRecordedIt) {
 }
 
 TEST_F(ClothHeldSchedule, OverridesTheEnergyCheck) {
-  ASSERT_GT(split_steps(cloth.schedule()), 2);
+  ASSERT_GT(test::split_steps(cloth.schedule()), 2);
   // Every step held whole: no step splits, and the motion differs from the checked one.
   cloth.hold_schedule(ClothSystem::StepSchedule(scene.time.steps(), std::vector<std::uint8_t>{0}));
   problem.evaluate(z, nullptr);
@@ -80,7 +64,7 @@ TEST_F(ClothHeldSchedule, OverridesTheEnergyCheck) {
 // The exact adjoint of a held rollout is its gradient: central differences at two step sizes agree with
 // it at a perturbed control where steps are split, and no sample meets a jump.
 TEST_F(ClothHeldSchedule, GradientMatchesFiniteDifferencesWithSplitSteps) {
-  ASSERT_GT(split_steps(cloth.schedule()), 2);
+  ASSERT_GT(test::split_steps(cloth.schedule()), 2);
   cloth.hold_schedule(cloth.schedule());
   for (const double eps : {1e-4, 3e-5}) {
     const GradcheckResult r = gradcheck(problem, z, {.samples = 24, .eps = eps, .seed = 5});
