@@ -19,6 +19,7 @@ namespace kf {
 
 class BodyCollider final : public Collider {
  public:
+  const char* name() const override { return "body"; }
   // triangles: #T by 3 indices into vertex_count body vertices. thickness, search, ramp: metres;
   // stiffness: N/m. A particle more than `search` metres inside the body gets no force (the open shells'
   // inside is a guess far from the surface).

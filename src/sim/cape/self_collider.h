@@ -22,6 +22,7 @@ namespace kf {
 
 class SelfCollider final : public Collider {
  public:
+  const char* name() const override { return "self contact"; }
   // particles: p; thickness, ramp: metres; stiffness: N/m.
   SelfCollider(int particles, double thickness, double stiffness, double ramp);
 

@@ -9,7 +9,6 @@
 #include <tbb/partitioner.h>
 
 #include "core/error.h"
-#include "sim/cape/body_collider.h"
 #include "sim/cape/self_collider.h"
 #include "sim/cloth/imperfection.h"
 #include "sim/cloth/mesh_layout.h"
@@ -360,11 +359,7 @@ std::string ClothSystem::describe() const {
   // self contact), so a count never includes colliders the scene file does not show.
   std::string names;
   for (size_t k = 0; k < colliders_.size(); ++k) {
-    const Collider* c = colliders_[k].get();
-    const char* name = k < spec_.colliders.size()             ? type_name(spec_.colliders[k])
-                       : dynamic_cast<const SelfCollider*>(c) ? "self contact"
-                       : dynamic_cast<const BodyCollider*>(c) ? "body"
-                                                              : "added";
+    const char* name = k < spec_.colliders.size() ? type_name(spec_.colliders[k]) : colliders_[k]->name();
     names += (names.empty() ? "" : ", ") + std::string(name);
   }
   const size_t nc = colliders_.size();

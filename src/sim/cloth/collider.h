@@ -37,6 +37,8 @@ struct ContactForce {
 class Collider {
  public:
   virtual ~Collider() = default;
+  // What a summary calls a collider the system adds beyond the scene's own (which are named by their type).
+  virtual const char* name() const { return "added"; }
   // The state (x, v: 3p) every contact query until the next call is about: the cloth calls it before each
   // assembly. Only a pair collider (self contact) reads it, to find each particle's neighbours.
   virtual void set_state(const VecX& /*x*/, const VecX& /*v*/) {}
