@@ -9,22 +9,13 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/hash.h"
 
 namespace kf {
 namespace {
 constexpr char kMagic[8] = {'K', 'F', 'E', 'V', 'A', 'L', '0', '2'};
 constexpr std::uint8_t kDiverged = 1, kUnstable = 2, kReached = 4;
 constexpr int kControlKinds = int(ControlKind::kPerFrameLattice) + 1;
-
-// FNV-1a, 64 bits: any changed, added or lost byte changes it (short of a deliberate forgery).
-std::uint64_t fnv1a(const char* data, size_t n) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (size_t i = 0; i < n; ++i) {
-    h ^= std::uint8_t(data[i]);
-    h *= 0x100000001b3ULL;
-  }
-  return h;
-}
 
 template <typename T>
 void put(std::string& out, const T& v) {

@@ -10,6 +10,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/file_name.h"
+#include "core/hash.h"
 #include "core/warnings.h"
 #include "sim/cloth/cloth_split_pattern.h"
 
@@ -41,12 +42,7 @@ bool get(std::istream& in, T& value) {
 }
 }  // namespace
 
-std::uint64_t controls_fingerprint(const VecX& z) {
-  std::uint64_t h = 14695981039346656037ull;
-  const auto* bytes = reinterpret_cast<const unsigned char*>(z.data());
-  for (std::size_t i = 0; i < std::size_t(z.size()) * sizeof(double); ++i) h = (h ^ bytes[i]) * 1099511628211ull;
-  return h;
-}
+std::uint64_t controls_fingerprint(const VecX& z) { return fnv1a(z.data(), std::size_t(z.size()) * sizeof(double)); }
 
 void save_schedule(const fs::path& path, const StepSchedule& schedule, const VecX& z, int substeps, int steps) {
   const ClothSystem::StepSchedule* held = cloth_split_steps(schedule);
