@@ -62,30 +62,35 @@ struct Window {
   int start;         // its first controlled frame
   int until;         // the frame its keyframes count up to (kAllKeyframes: all)
   bool lead;         // the first (shortest) window of its keyframe: the tame gradient, the larger share
+  bool bottom;       // the one reaching down to where its keyframe's windows end
+  bool per_particle; // the scene's own forces (not the lattice) over its keyframe's first window's frames
 };
 
 // Windows grown backwards from the keyframe at `frame` down to `lower`: frame - w, frame - 2w, ... above
-// lower, then lower.
-void grow_back(std::vector<Window>& out, int frame, int lower, int window_frames, int until) {
+// lower, then lower. With `per_particle`, then the scene's own forces over the first window's frames.
+void grow_back(std::vector<Window>& out, int frame, int lower, int window_frames, int until, bool per_particle) {
   bool lead = true;
-  for (long w = window_frames; frame - w > lower; w *= 2, lead = false) out.push_back({int(frame - w), until, lead});
-  out.push_back({lower, until, lead});
+  for (long w = window_frames; frame - w > lower; w *= 2, lead = false)
+    out.push_back({int(frame - w), until, lead, false, false});
+  out.push_back({lower, until, lead, true, false});
+  if (per_particle) out.push_back({std::max(lower, frame - window_frames), until, false, false, true});
 }
 
 // The windows in time order: each keyframe's grown back from it, the earliest's to controls.from_frame and
-// each later one's to the keyframe before it, only keyframes up to its own counting (the last: all).
-std::vector<Window> plan_windows(const Scene& scene) {
+// each later one's to the keyframe before it, only keyframes up to its own counting (the last: all). Lattice
+// windows end with a per-particle window over their keyframe's first window's frames.
+std::vector<Window> plan_windows(const Scene& scene, bool lattice) {
   const ControlSpec& c = scene.controls;
   const std::vector<int> frames = keyframe_frames(scene);
   std::vector<Window> windows;
   if (frames.size() < 2) {
-    grow_back(windows, last_keyframe(scene), c.from_frame, scene.optimizer.window_frames, kAllKeyframes);
+    grow_back(windows, last_keyframe(scene), c.from_frame, scene.optimizer.window_frames, kAllKeyframes, lattice);
     return windows;
   }
   int lower = c.from_frame;
   for (size_t k = 0; k < frames.size(); ++k) {
     grow_back(windows, frames[k], lower, scene.optimizer.window_frames,
-              k + 1 < frames.size() ? frames[k] : kAllKeyframes);
+              k + 1 < frames.size() ? frames[k] : kAllKeyframes, lattice);
     lower = frames[k];
   }
   return windows;
@@ -96,21 +101,27 @@ std::vector<Window> plan_windows(const Scene& scene) {
 // The first (shortest) window of a keyframe gets the larger share: its gradient is the only tame one, so it
 // does most of the work and is still descending at an equal share, while longer windows mostly stall within
 // a few evaluations and pass their unspent budget on. Per-frame forces act on the 3 x 3 lattice in every
-// window, then per particle over the last (the whole) window; with keyframes at several frames a last stage
-// of the scene's own controls over the whole horizon follows the windows.
+// window; after a keyframe's lattice windows its forces act per particle over that keyframe's first window
+// (the forces before it held), where a per-particle gradient is still tame, and, after every keyframe's, per
+// particle over the whole horizon. A later lattice window would fit a per-particle window's forces back onto
+// the lattice, so the per-particle window comes after its keyframe's lattice windows, not after the first.
+// With keyframes at several frames a last stage of the scene's own controls over the whole horizon follows
+// the windows.
 std::vector<StageSpec> window_stages(const Scene& scene, int budget, std::vector<int>* judged_until) {
   const ControlSpec& c = scene.controls;
   const bool lattice = c.kind == ControlKind::kPerFrame;
-  std::vector<Window> windows = plan_windows(scene);
+  std::vector<Window> windows = plan_windows(scene, lattice);
   const bool ordered = keyframe_frames(scene).size() > 1;
   const int extra = lattice || ordered ? 1 : 0;  // the last stage over the whole horizon, when it is not a window
+  const auto too_many = [&] { return int(windows.size() + extra) * kMinStageEvaluations > budget; };
   // A budget below what every window needs plans fewer windows, rather than each cut short: the middle
-  // windows of each keyframe go first, the longest before the shorter; each keyframe keeps its first
-  // window and the one reaching down to where its windows end.
-  for (size_t k = windows.size(); k-- > 0 && int(windows.size() + extra) * kMinStageEvaluations > budget;) {
-    const bool bottom = k + 1 == windows.size() || windows[k + 1].until != windows[k].until;
-    if (!windows[k].lead && !bottom) windows.erase(windows.begin() + long(k));
-  }
+  // windows of each keyframe go first, the longest before the shorter; then the per-particle windows. Each
+  // keyframe keeps its first window and the one reaching down to where its windows end.
+  for (size_t k = windows.size(); k-- > 0 && too_many();)
+    if (!windows[k].lead && !windows[k].bottom && !windows[k].per_particle) windows.erase(windows.begin() + long(k));
+  if (too_many())
+    windows.erase(std::remove_if(windows.begin(), windows.end(), [](const Window& w) { return w.per_particle; }),
+                  windows.end());
   // The last window of a single keyframe, when it is not on the lattice, is the scene's own controls.
   const int n = int(windows.size()) + extra;
   int leads = 0;
@@ -129,7 +140,7 @@ std::vector<StageSpec> window_stages(const Scene& scene, int budget, std::vector
     if (k + 1 < n) {
       ControlSpec window = c;
       window.from_frame = windows[k].start;
-      if (lattice) window.kind = ControlKind::kPerFrameLattice;
+      if (lattice && !windows[k].per_particle) window.kind = ControlKind::kPerFrameLattice;
       s.controls = window;
     }
     stages.push_back(s);
@@ -141,7 +152,8 @@ std::vector<StageSpec> window_stages(const Scene& scene, int budget, std::vector
 namespace {
 
 // "windows from frames 23, 18, 8, 0 to frame 28", or in keyframe order "windows to frame 12 from frames 7,
-// 2, 0, then to frame 28 (every keyframe) from frames 23, 18, 12".
+// 2, 0, then to frame 28 (every keyframe) from frames 23, 18, 12"; a per-particle window after a keyframe's
+// lattice windows as ", then per particle from frame 7".
 std::string describe(const std::vector<StageSpec>& stages, const std::vector<int>& until, int last, int scene_from) {
   std::ostringstream os;
   const bool ordered = std::find(until.begin(), until.end(), kAllKeyframes) != until.begin();
@@ -149,15 +161,25 @@ std::string describe(const std::vector<StageSpec>& stages, const std::vector<int
   const size_t windows = ordered || lattice ? stages.size() - 1 : stages.size();
   os << "windows";
   for (size_t k = 0; k < windows; ++k) {
+    const int from = stages[k].controls ? stages[k].controls->from_frame : scene_from;
+    const bool per_particle =
+        lattice && stages[k].controls && stages[k].controls->kind != ControlKind::kPerFrameLattice;
     const bool group_start = k == 0 || until[k] != until[k - 1];
+    if (per_particle) {
+      if (!ordered) os << " to frame " << last;
+      os << ", then per particle from frame " << from;
+      continue;
+    }
     if (ordered && group_start)
       os << (k ? ", then" : "") << " to frame " << (until[k] == kAllKeyframes ? last : until[k])
          << (until[k] == kAllKeyframes ? " (every keyframe)" : "") << " from frames ";
     else if (!ordered && k == 0) os << " from frames ";
     else os << ", ";
-    os << (stages[k].controls ? stages[k].controls->from_frame : scene_from);
+    os << from;
   }
-  if (!ordered) os << " to frame " << last;
+  const bool ends_per_particle = windows > 0 && lattice && stages[windows - 1].controls &&
+                                 stages[windows - 1].controls->kind != ControlKind::kPerFrameLattice;
+  if (!ordered && !ends_per_particle) os << " to frame " << last;
   return os.str();
 }
 
@@ -260,7 +282,8 @@ StagePlan plan_stages(const Scene& scene) {
     else os << " (the sheet meets colliders or a body)";
     os << ": " << describe(plan.stages, plan.judged_until, last, c.from_frame);
     if (c.kind == ControlKind::kPerFrame)
-      os << ", each on a 3 x 3 lattice of forces over the sheet, then one force per particle from frame " << c.from_frame;
+      os << " (all but the per-particle ones on a 3 x 3 lattice of forces over the sheet), then one force per particle "
+            "from frame " << c.from_frame;
     else if (keyframe_frames(scene).size() > 1)
       os << ", then the scene's forces from frame " << c.from_frame;
   } else {

@@ -10,7 +10,10 @@
 //    twice, four times ... as long, down to controls.from_frame; each stage starts from the forces
 //    the last one found (new frames without force), so a longer window can only improve on it. Below the
 //    threshold, one stage, and the windows if it ends early with evaluations left. Per-frame
-//    forces act on a 3 x 3 lattice over the sheet in every window, then per particle over the whole one.
+//    forces act on a 3 x 3 lattice over the sheet in every window; after each keyframe's lattice windows, per
+//    particle over that keyframe's first (shortest) window, the forces before it held (a per-particle
+//    gradient over the whole horizon is amplified where the window's is tame: its line search stalls at once);
+//    then per particle over the whole horizon.
 //    With keyframes at several frames the windows go in time order: those grown back from the earliest
 //    keyframe (later ones left out, so it is met first), then those grown back from the next down to the
 //    keyframe before it (the forces before the window held as found), and so on; the last stage optimises

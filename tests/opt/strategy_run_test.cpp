@@ -294,5 +294,30 @@ TEST(StrategyRun, KeyframesAtSeveralFramesAreSteeredInTimeOrder) {
   EXPECT_LE(com_miss(*r.problem, 12, early), kTolerance);
 }
 
+// Per-frame forces: each keyframe's lattice windows, then a per-particle window over its first window's
+// frames, then the whole horizon per particle. Each per-particle stage starts where the stage before it
+// ended (the lattice forces spread over the particles, those before the window held): without an effort
+// term the keyframe terms alone are φ, so its first φ is the last stage's best.
+TEST(StrategyRun, PerParticleWindowsStartWhereTheLatticeWindowsEnded) {
+  const Scene scene = toy_scene(R"({"split_schedule": "adaptive", "stop_when_reached": false, "window_frames": 5})",
+                                R"({"kind": "per_frame", "alpha": 0})");
+  StagePlan plan;
+  plan.stages = window_stages(scene, 240, &plan.judged_until);
+  std::vector<int> starts;
+  for (const auto& st : plan.stages) starts.push_back(st.controls ? st.controls->from_frame : -1);
+  ASSERT_EQ(starts, (std::vector<int>{7, 2, 0, 7, 23, 18, 12, 23, -1}));
+  const ToyRun run = run_toy(scene, plan);
+  const StrategyResult& r = run.result;
+  ASSERT_EQ(r.stages.size(), plan.stages.size());
+  for (size_t s : {size_t(3), size_t(7), size_t(8)}) {
+    EXPECT_EQ(r.stages[s].kind, ControlKind::kPerFrame) << "stage " << s;
+    EXPECT_EQ(r.stages[s - 1].kind, s == 8 ? ControlKind::kPerFrame : ControlKind::kPerFrameLattice) << "stage " << s;
+    EXPECT_GT(r.stages[s - 1].objective_end, 0) << "stage " << s;
+    EXPECT_NEAR(r.stages[s].objective_start, r.stages[s - 1].objective_end, 1e-9 * r.stages[s - 1].objective_end)
+        << "stage " << s;
+    EXPECT_LE(r.stages[s].objective_end, r.stages[s].objective_start) << "stage " << s;
+  }
+}
+
 }  // namespace
 }  // namespace kf

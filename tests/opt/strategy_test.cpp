@@ -98,26 +98,34 @@ TEST(Strategy, ClothForcesGrowWindowsBackwardsFromEachKeyframeInTimeOrder) {
   const Scene scene = strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"max_evaluations": 300, "window_growth": 1})");
   const StagePlan plan = plan_stages(scene);
   EXPECT_GT(plan.growth, 1);
-  // Keyframes at frames 12 and 28: windows grown back from 12 (only it counts), then from 28 down to 12
-  // (both count), each on the lattice, then per particle over the whole horizon.
-  EXPECT_EQ(window_starts(plan.stages, 0), (std::vector<int>{7, 2, 0, 23, 18, 12, 0}));
-  EXPECT_EQ(plan.judged_until, (std::vector<int>{12, 12, 12, kAllKeyframes, kAllKeyframes, kAllKeyframes, kAllKeyframes}));
+  // Keyframes at frames 12 and 28: windows grown back from 12 (only it counts) on the lattice, then per
+  // particle over its first window, then from 28 down to 12 (both count) the same way, then per particle
+  // over the whole horizon.
+  EXPECT_EQ(window_starts(plan.stages, 0), (std::vector<int>{7, 2, 0, 7, 23, 18, 12, 23, 0}));
+  EXPECT_EQ(plan.judged_until, (std::vector<int>{12, 12, 12, 12, kAllKeyframes, kAllKeyframes, kAllKeyframes,
+                                                 kAllKeyframes, kAllKeyframes}));
   for (size_t k = 0; k + 1 < plan.stages.size(); ++k)
-    EXPECT_EQ(plan.stages[k].controls->kind, ControlKind::kPerFrameLattice) << "stage " << k;
+    EXPECT_EQ(plan.stages[k].controls->kind, k == 3 || k == 7 ? ControlKind::kPerFrame : ControlKind::kPerFrameLattice)
+        << "stage " << k;
   int budget = 0;
   for (const auto& s : plan.stages) {
     budget += s.max_evaluations;
     EXPECT_EQ(s.substeps, 2);
   }
   EXPECT_EQ(budget, 300);
-  // Each keyframe's shortest window (the tame gradient) shares half the budget.
+  // Each keyframe's shortest lattice window (the tame gradient) shares half the budget; the other windows,
+  // the per-particle ones included, the rest.
   EXPECT_EQ(plan.stages[0].max_evaluations, 75);
-  EXPECT_EQ(plan.stages[3].max_evaluations, 75);
-  EXPECT_EQ(plan.stages[1].max_evaluations, 30);
+  EXPECT_EQ(plan.stages[4].max_evaluations, 75);
+  EXPECT_EQ(plan.stages[1].max_evaluations, 21);
+  EXPECT_EQ(plan.stages[3].max_evaluations, 21);
+  EXPECT_EQ(plan.stages.back().max_evaluations, 24);
   EXPECT_FALSE(plan.stages.back().controls);  // the last stage optimises the scene's own controls
   EXPECT_TRUE(plan.scaled_first_step);
-  EXPECT_NE(plan.why.find("windows to frame 12 from frames 7, 2, 0, then to frame 28 (every keyframe) from frames 23, "
-                          "18, 12, each on a 3 x 3 lattice"),
+  EXPECT_NE(plan.why.find("windows to frame 12 from frames 7, 2, 0, then per particle from frame 7, then to frame 28 "
+                          "(every keyframe) from frames 23, 18, 12, then per particle from frame 23 (all but the "
+                          "per-particle ones on a 3 x 3 lattice of forces over the sheet), then one force per "
+                          "particle from frame 0"),
             std::string::npos)
       << plan.why;
   // Per-step forces have no lattice: their windows are per particle. From frame 20 only the keyframe at 28
@@ -137,11 +145,11 @@ TEST(Strategy, ClothForcesGrowWindowsBackwardsFromEachKeyframeInTimeOrder) {
   EXPECT_FALSE(one.scaled_first_step);  // a run the strategy leaves alone runs as it did without it
   EXPECT_TRUE(one.windows_on_early_end);     // ... unless its one stage stalls with evaluations left
   EXPECT_FALSE(plan.windows_on_early_end);
-  // What a stalled stage leaves: the same windows sharing it.
+  // What a stalled stage leaves: the same windows sharing it, fewer where it does not fit them all.
   std::vector<int> until;
   const std::vector<StageSpec> after = window_stages(tame, 101, &until);
-  EXPECT_EQ(window_starts(after, 0), (std::vector<int>{7, 2, 0, 23, 18, 12, 0}));
-  EXPECT_EQ(until, plan.judged_until);
+  EXPECT_EQ(window_starts(after, 0), (std::vector<int>{7, 2, 0, 7, 23, 12, 23, 0}));
+  EXPECT_EQ(until, (std::vector<int>{12, 12, 12, 12, kAllKeyframes, kAllKeyframes, kAllKeyframes, kAllKeyframes}));
   int left = 0;
   for (const auto& s : after) left += s.max_evaluations;
   EXPECT_EQ(left, 101);
@@ -161,9 +169,40 @@ TEST(Strategy, ASmallBudgetPlansFewerWindows) {
     EXPECT_GE(s.max_evaluations, 10);  // the shortest windows 15, the others 10
   }
   EXPECT_EQ(budget, 60);
-  // A budget that fits them all keeps them all.
-  const Scene full = strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"max_evaluations": 84, "window_growth": 1})");
-  EXPECT_EQ(plan_stages(full).stages.size(), 7u);
+  // Middle windows go before the per-particle ones; a budget that fits them all keeps them all.
+  const Scene more = strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"max_evaluations": 84, "window_growth": 1})");
+  const StagePlan more_plan = plan_stages(more);
+  EXPECT_EQ(window_starts(more_plan.stages, 0), (std::vector<int>{7, 0, 7, 23, 12, 23, 0}));
+  EXPECT_EQ(more_plan.stages[2].controls->kind, ControlKind::kPerFrame);
+  const Scene full = strategy_scene(kCloth, R"({"kind": "per_frame"})", R"({"max_evaluations": 108, "window_growth": 1})");
+  EXPECT_EQ(plan_stages(full).stages.size(), 9u);
+}
+
+// A single keyframe: its lattice windows, one per-particle window over the first one's frames, then the whole
+// horizon; per-step forces, whose windows are per particle already, get none.
+TEST(Strategy, PerFrameForcesGetAPerParticleWindowAfterTheirLatticeWindows) {
+  const Scene scene = parse_scene(R"({"time": {"fps": 30, "substeps": 2, "frames": 30}, "cloth": {"nx": 2, "ny": 2},
+    "objectives": [{"type": "center_of_mass", "frame": 28, "target": [0.3, 0.1, 0.2]}],
+    "controls": {"kind": "per_frame"}, "optimizer": {"window_growth": 1, "window_frames": 5}})",
+                                  "single.json");
+  const StagePlan plan = plan_stages(scene);
+  EXPECT_EQ(window_starts(plan.stages, 0), (std::vector<int>{23, 18, 8, 0, 23, 0}));
+  ASSERT_EQ(plan.stages.size(), 6u);
+  EXPECT_EQ(plan.stages[4].controls->kind, ControlKind::kPerFrame);
+  EXPECT_EQ(plan.stages[3].controls->kind, ControlKind::kPerFrameLattice);
+  EXPECT_FALSE(plan.stages[5].controls);
+  EXPECT_EQ(plan.stages[0].max_evaluations, 150);
+  EXPECT_EQ(plan.stages[4].max_evaluations, 30);
+  EXPECT_NE(plan.why.find("windows from frames 23, 18, 8, 0 to frame 28, then per particle from frame 23 (all but"),
+            std::string::npos)
+      << plan.why;
+  Scene per_step = scene;
+  per_step.controls.kind = ControlKind::kPerStep;
+  std::vector<int> until;
+  const std::vector<StageSpec> steps = window_stages(per_step, 300, &until);
+  EXPECT_EQ(window_starts(steps, 0), (std::vector<int>{23, 18, 8, 0}));
+  for (const auto& s : steps)
+    if (s.controls) EXPECT_EQ(s.controls->kind, ControlKind::kPerStep);
 }
 
 // The growth is read from the gradient's frames: a keyframe's own frame's forces against earlier ones.
