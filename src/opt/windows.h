@@ -62,7 +62,8 @@ StagePlan plan_stages(const Scene& scene);
 
 // The windows for per-step or per-frame forces, sharing `budget` evaluations: grown back from the last
 // keyframe (the first window half of them), or, with keyframes at several frames, grown back from each
-// keyframe in time order (the first window of each keyframe sharing half). `judged_until`, when given,
+// keyframe in time order (the first window of each keyframe sharing half). Per-frame forces' windows are on
+// the lattice, each keyframe's followed by a per-particle window over its first window's frames. `judged_until`, when given,
 // gets each stage's keyframe frame (kAllKeyframes: every keyframe counts).
 std::vector<StageSpec> window_stages(const Scene& scene, int budget, std::vector<int>* judged_until = nullptr);
 
