@@ -6,7 +6,7 @@
 // Run with --gtest_also_run_disabled_tests --gtest_filter='KinkProbeTool.*' and
 //   KF_KINK_SCENE=scene.json KF_KINK_RUN=run_dir KF_KINK_OUT=out.json
 //   [KF_KINK_SOLVER=direct] [KF_KINK_POINTS=41] [KF_KINK_MIN=1e-10] [KF_KINK_MAX=1e-5] [KF_KINK_BISECT=40]
-//   [KF_KINK_RAMP=cloth.contact_ramp] [KF_KINK_STIFFNESS=character.body.stiffness]
+//   [KF_KINK_RAMP=cloth.contact_ramp] [KF_KINK_STIFFNESS=character.body.stiffness] [KF_KINK_AT_START=1]
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -237,9 +237,16 @@ TEST(KinkProbeTool, DISABLED_Measure) {
                   scene.time.steps());
   Problem problem(scene, scene.time, sys);
   int substeps = 0;
-  const VecX z = load_controls(std::filesystem::path(run) / "controls.bin", &substeps);
+  // KF_KINK_AT_START=1: at the scene's initial guess (the run's first point) under the schedule it records.
+  const bool at_start = std::getenv("KF_KINK_AT_START") && std::atoi(std::getenv("KF_KINK_AT_START"));
+  const VecX z = at_start ? problem.initial_guess() : load_controls(std::filesystem::path(run) / "controls.bin", &substeps);
   ASSERT_EQ(z.size(), problem.size());
-  if (const StepSchedule s = run_schedule(run, scene, z, substeps); !s.empty()) sys.hold_step_schedule(s);
+  if (at_start) {
+    problem.evaluate(z, nullptr);
+    sys.hold_step_schedule(sys.step_schedule());
+  } else if (const StepSchedule s = run_schedule(run, scene, z, substeps); !s.empty()) {
+    sys.hold_step_schedule(s);
+  }
 
   VecX g(z.size());
   auto at = [&](double t, const VecX& d) {
