@@ -342,8 +342,14 @@ TEST(KinkProbeTool, DISABLED_Nonlinearity) {
                   scene.time.steps());
   Problem problem(scene, scene.time, sys);
   int substeps = 0;
-  const VecX z = load_controls(std::filesystem::path(run) / "controls.bin", &substeps);
-  if (const StepSchedule s = run_schedule(run, scene, z, substeps); !s.empty()) sys.hold_step_schedule(s);
+  const bool at_start = std::getenv("KF_KINK_AT_START") && std::atoi(std::getenv("KF_KINK_AT_START"));
+  const VecX z = at_start ? problem.initial_guess() : load_controls(std::filesystem::path(run) / "controls.bin", &substeps);
+  if (at_start) {
+    problem.evaluate(z, nullptr);
+    sys.hold_step_schedule(sys.step_schedule());
+  } else if (const StepSchedule s = run_schedule(run, scene, z, substeps); !s.empty()) {
+    sys.hold_step_schedule(s);
+  }
   VecX g(z.size());
   problem.evaluate(z, &g);
   const VecX d = -g / g.norm();
