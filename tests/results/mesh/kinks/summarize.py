@@ -40,7 +40,7 @@ def row(path):
             sorted({k for r in line for k in r["changes_since_previous"] if k in DISCONTINUOUS})),
     }
     b = d.get("bisection")
-    if b:
+    if b and b["steps"]:  # KF_KINK_BISECT=0 leaves the first departing interval unbisected: nothing to name
         kinds = [k for k in b["changes"] if k != "feature_change_continuous"]
         out.update({
             "bisected_to_width": b["to"] - b["from"],
@@ -49,6 +49,8 @@ def row(path):
             "bisected_change": ";".join(
                 "%s(step %d, %s)" % (k, b["changes"][k]["first_step"], b["changes"][k]["example"]) for k in kinds)
             or "none (smooth to the resolution of t)",
+            # the earliest step's kind: the cause; changes at later steps follow from it
+            "bisected_kind": min(kinds, key=lambda k: b["changes"][k]["first_step"]) if kinds else "none",
         })
     nl = nonlinearity_file(path)
     if nl:
