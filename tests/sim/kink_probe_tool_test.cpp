@@ -3,7 +3,8 @@
 // particle's body contact zone, closest triangle, feature and point at each step; PCG iterations, split
 // substeps and self contacts per step), names the discrete changes between neighbouring points, and bisects
 // the first interval where φ departs from its slopes down to the change that makes the jump.
-// Run with --gtest_also_run_disabled_tests --gtest_filter='KinkProbeTool.*' and
+// Run with KEYFRAME_NO_FP_TRAPS=1 (Embree's point queries) --gtest_also_run_disabled_tests
+// --gtest_filter='KinkProbeTool.*' and
 //   KF_KINK_SCENE=scene.json KF_KINK_RUN=run_dir KF_KINK_OUT=out.json
 //   [KF_KINK_SOLVER=direct] [KF_KINK_POINTS=41] [KF_KINK_MIN=1e-10] [KF_KINK_MAX=1e-5] [KF_KINK_BISECT=40]
 //   [KF_KINK_RAMP=cloth.contact_ramp] [KF_KINK_STIFFNESS=character.body.stiffness] [KF_KINK_AT_START=1]
