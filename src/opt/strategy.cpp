@@ -15,6 +15,7 @@
 #include "opt/term_breakdown.h"
 #include "opt/throw_fit.h"
 #include "opt/uncontrolled_floor.h"
+#include "opt/window_extension.h"
 #include "sim/make_system.h"
 
 namespace kf {
@@ -308,8 +309,59 @@ std::unique_ptr<System> stage_system(const Run& run, size_t s, double h) {
   return scale == 1.0 ? run.hooks.make_system(h) : make_system(with_friction_scaled(run.scene, scale), h);
 }
 
+// A stage that is not the last, stopped by its limit while still falling, goes on from its best point with
+// evaluations borrowed from the stages after it (opt/window_extension.h); `res` becomes the whole stage's.
+void go_on_while_falling(Run& run, std::vector<StageSpec>& stages, size_t s, OptimizerSpec spec,
+                         const RestartHooks& hooks, OptimizeResult& res) {
+  const WindowExtensionRule rule;
+  if (run.fixed_budgets || s + 1 >= stages.size()) return;
+  std::vector<int> later;
+  for (size_t k = s + 1; k < stages.size(); ++k) later.push_back(stages[k].max_evaluations);
+  const int own = spec.max_evaluations;
+  int cap_left = borrow_cap(later, rule);
+  while (!res.interrupted && !(run.stop && run.stop->load()) &&
+         still_falling_at_limit(res.reason, res.history, rule)) {
+    const int chunk = chunk_to_borrow(own, cap_left, later, rule);
+    if (chunk == 0) return;
+    lend(later, chunk, rule);
+    cap_left -= chunk;
+    stages[s].max_evaluations += chunk;
+    for (size_t k = s + 1; k < stages.size(); ++k) stages[k].max_evaluations = later[k - s - 1];
+    std::ostringstream os;
+    os << std::setprecision(3) << "still falling at its limit (x" << last_tenth_ratio(res.history)
+       << " over its last tenth): " << chunk << " more evaluations, borrowed from the stages after it";
+    run.log.say(os.str());
+    const int used = int(res.history.size());
+    const double before = res.seconds;
+    RestartHooks more_hooks = hooks;
+    if (hooks.on_eval)
+      more_hooks.on_eval = [&hooks, used, before](const EvaluationRecord& e0) {
+        EvaluationRecord e = e0;
+        e.evaluation += used;
+        e.seconds += before;
+        hooks.on_eval(e);
+      };
+    spec.max_evaluations = chunk;
+    OptimizeResult more =
+        minimize_with_restarts(*run.r.problem, spec, run.scene.optimizer.restarts, res.z, more_hooks, run.stop, run.r.tape);
+    more.seconds += before;
+    more.evaluations += res.evaluations;
+    more.capped_trials += res.capped_trials;
+    for (EvaluationRecord& e : more.history) {
+      e.evaluation += used;
+      e.seconds += before;
+    }
+    more.history.insert(more.history.begin(), res.history.begin(), res.history.end());
+    if (!(more.phi < res.phi)) {  // no progress: the earlier best point stands
+      more.z = res.z;
+      more.phi = res.phi;
+    }
+    res = std::move(more);
+  }
+}
+
 // Stage s of the plan: its system (the first is built already), problem and optimisation.
-void run_stage(Run& run, const std::vector<StageSpec>& stages, size_t s) {
+void run_stage(Run& run, std::vector<StageSpec>& stages, size_t s) {
   StrategyResult& r = run.r;
   r.time.substeps = stages[s].substeps;
   const bool friction_changed = s > 0 && friction_scale(run, s) != friction_scale(run, s - 1);
@@ -351,8 +403,8 @@ void run_stage(Run& run, const std::vector<StageSpec>& stages, size_t s) {
   if (r.hold_splits) hooks.before_restart = [&](const VecX& z, double& phi) { return rehold_schedule(r, z, phi); };
   hooks.reached = keyframes_reached(run, problem, judged_until(run, s));
   run.log.stage_started(spec.max_evaluations);
-  const OptimizeResult res =
-      minimize_with_restarts(problem, spec, run.scene.optimizer.restarts, r.z, hooks, run.stop, r.tape);
+  OptimizeResult res = minimize_with_restarts(problem, spec, run.scene.optimizer.restarts, r.z, hooks, run.stop, r.tape);
+  go_on_while_falling(run, stages, s, spec, hooks, res);
   run.log.stage_finished();
   record_stage(run, res);
   run.stage_ends.push_back(as_scene_controls(run, res.z));
