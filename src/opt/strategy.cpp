@@ -314,19 +314,17 @@ std::unique_ptr<System> stage_system(const Run& run, size_t s, double h) {
 void go_on_while_falling(Run& run, std::vector<StageSpec>& stages, size_t s, OptimizerSpec spec,
                          const RestartHooks& hooks, OptimizeResult& res) {
   const WindowExtensionRule rule;
-  if (run.fixed_budgets || s + 1 >= stages.size()) return;
-  std::vector<int> later;
-  for (size_t k = s + 1; k < stages.size(); ++k) later.push_back(stages[k].max_evaluations);
-  const int own = spec.max_evaluations;
-  int cap_left = borrow_cap(later, rule);
+  if (!rule.on || run.fixed_budgets || s + 1 >= stages.size()) return;
+  std::vector<int> limits;
+  for (const StageSpec& st : stages) limits.push_back(st.max_evaluations);
+  limits[s] = spec.max_evaluations;  // its own share (less Gauss-Newton's passes, on a large thrown sheet)
+  StageBorrowing borrowing(limits, s, rule);
   while (!res.interrupted && !(run.stop && run.stop->load()) &&
          still_falling_at_limit(res.reason, res.history, rule)) {
-    const int chunk = chunk_to_borrow(own, cap_left, later, rule);
+    const int chunk = borrowing.next(limits);
     if (chunk == 0) return;
-    lend(later, chunk, rule);
-    cap_left -= chunk;
     stages[s].max_evaluations += chunk;
-    for (size_t k = s + 1; k < stages.size(); ++k) stages[k].max_evaluations = later[k - s - 1];
+    for (size_t k = s + 1; k < stages.size(); ++k) stages[k].max_evaluations = limits[k];
     std::ostringstream os;
     os << std::setprecision(3) << "still falling at its limit (x" << last_tenth_ratio(res.history)
        << " over its last tenth): " << chunk << " more evaluations, borrowed from the stages after it";

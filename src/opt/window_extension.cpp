@@ -66,4 +66,23 @@ void lend(std::vector<int>& later, int borrowed, const WindowExtensionRule& rule
   CHECK_EQ(taken, borrowed);
 }
 
+StageBorrowing::StageBorrowing(const std::vector<int>& limits, size_t stage, const WindowExtensionRule& rule)
+    : stage_(stage), own_(stage < limits.size() ? limits[stage] : 0), cap_left_(0), rule_(rule) {
+  if (stage + 1 < limits.size())
+    cap_left_ = borrow_cap(std::vector<int>(limits.begin() + long(stage) + 1, limits.end()), rule);
+}
+
+int StageBorrowing::next(std::vector<int>& limits) {
+  if (stage_ + 1 >= limits.size()) return 0;
+  std::vector<int> later(limits.begin() + long(stage_) + 1, limits.end());
+  const int chunk = chunk_to_borrow(own_, cap_left_, later, rule_);
+  if (chunk == 0) return 0;
+  lend(later, chunk, rule_);
+  std::copy(later.begin(), later.end(), limits.begin() + long(stage_) + 1);
+  limits[stage_] += chunk;
+  cap_left_ -= chunk;
+  borrowed_ += chunk;
+  return chunk;
+}
+
 }  // namespace kf

@@ -16,7 +16,8 @@
 namespace kf {
 
 struct WindowExtensionRule {
-  double min_fall = 0.01;    // the fraction the best objective must fall over the last tenth to go on
+  bool on = true;            // whether the strategy applies it
+  double min_fall = 0.005;   // the fraction the best objective must fall over the last tenth to go on
   double share = 0.5;        // at most this fraction of the later stages' evaluations is borrowed, in all
   int floor_per_stage = 12;  // every later stage keeps this many (the plan's smallest stage)
   int min_chunk = 12;        // fewer borrowed evaluations than this are not worth a fresh start
@@ -42,5 +43,19 @@ int borrow_cap(const std::vector<int>& later, const WindowExtensionRule& rule);
 // floor (the rounding's remainder from the last ones first), never below it. The sum falls by exactly
 // `borrowed`, which must be at most what they have above their floors.
 void lend(std::vector<int>& later, int borrowed, const WindowExtensionRule& rule);
+
+// One stage's borrowing over a plan's stage limits: each call to next() moves one chunk from the stages after
+// `stage` to it, in `limits` (their sum unchanged), and returns it; 0 once the cap or the floors leave too few.
+class StageBorrowing {
+ public:
+  StageBorrowing(const std::vector<int>& limits, size_t stage, const WindowExtensionRule& rule);
+  int next(std::vector<int>& limits);
+  int borrowed() const { return borrowed_; }
+
+ private:
+  size_t stage_;
+  int own_, cap_left_, borrowed_ = 0;
+  WindowExtensionRule rule_;
+};
 
 }  // namespace kf

@@ -50,9 +50,9 @@ TEST(WindowExtension, LastTenthRatioIsBestAtEndOverBestBeforeTheLastTenth) {
 }
 
 TEST(WindowExtension, GoesOnOnlyAtItsLimitWhileFallingFasterThanTheThreshold) {
-  const WindowExtensionRule rule;  // min_fall 1 %
+  const WindowExtensionRule rule;  // min_fall 0.5 %
   const auto falling = history_of(geometric(100, 0.998));  // ~2 % over the last 10
-  const auto slow = history_of(geometric(100, 0.9995));    // ~0.5 %
+  const auto slow = history_of(geometric(100, 0.9998));    // ~0.2 %: a stalled window
   EXPECT_TRUE(still_falling_at_limit(StopReason::kEvaluationLimit, falling, rule));
   EXPECT_FALSE(still_falling_at_limit(StopReason::kEvaluationLimit, slow, rule));
   for (StopReason r : {StopReason::kConverged, StopReason::kLineSearchStalled, StopReason::kKeyframesReached,
@@ -62,8 +62,9 @@ TEST(WindowExtension, GoesOnOnlyAtItsLimitWhileFallingFasterThanTheThreshold) {
 
 TEST(WindowExtension, ChunkIsTheStagesOwnShareWithinTheCapAndTheLaterFloors) {
   const WindowExtensionRule rule;  // share 1/2, floor 12, min_chunk 12
-  // drop-collider-9's plan at 300: the first window 75, then 30, 30, 30, 30, 75, 30.
-  const std::vector<int> later{30, 30, 30, 30, 75, 30};
+  // drop-collider-9's plan at 300 after its first window of 75: two more windows of its first keyframe, three
+  // of its second (the first of them 75) and the whole horizon.
+  const std::vector<int> later{30, 30, 75, 30, 30, 30};
   EXPECT_EQ(borrow_cap(later, rule), 112);
   EXPECT_EQ(chunk_to_borrow(75, 112, later, rule), 75);  // its own share first
   EXPECT_EQ(chunk_to_borrow(75, 37, later, rule), 37);   // then what the cap leaves
@@ -75,14 +76,14 @@ TEST(WindowExtension, ChunkIsTheStagesOwnShareWithinTheCapAndTheLaterFloors) {
 
 TEST(WindowExtension, LendingTakesExactlyTheBorrowedAndKeepsEveryFloor) {
   const WindowExtensionRule rule;
-  std::vector<int> later{30, 30, 30, 30, 75, 30};
+  std::vector<int> later{30, 30, 75, 30, 30, 30};
   const int before = sum(later);
   lend(later, 75, rule);
   EXPECT_EQ(sum(later), before - 75);
   for (int m : later) EXPECT_GE(m, rule.floor_per_stage);
   // In proportion to what each had above its floor: the 75 gives most.
   EXPECT_GT(30 - later[0], 0);
-  EXPECT_GT(75 - later[4], 2 * (30 - later[0]));
+  EXPECT_GT(75 - later[2], 2 * (30 - later[0]));
   lend(later, 37, rule);
   EXPECT_EQ(sum(later), before - 112);
   for (int m : later) EXPECT_GE(m, rule.floor_per_stage);
@@ -96,20 +97,30 @@ TEST(WindowExtension, LendingTakesExactlyTheBorrowedAndKeepsEveryFloor) {
 }
 
 TEST(WindowExtension, PlanInLimitsOutOverTwoChunks) {
-  // A window of 75 before stages of 30, 30, 30, 30, 75, 30 (300 in all), still falling after each chunk:
-  // it borrows 75, then 37 (the cap is half of the 225 after it), and the run's total stays 300.
+  // drop-collider-9's plan at 300; its first window, still falling after each chunk, borrows 75, then 37 (the
+  // cap is half of the 225 after it), then nothing; the run's total stays 300 and no stage before it changes.
   const WindowExtensionRule rule;
-  int window = 75;
-  std::vector<int> later{30, 30, 30, 30, 75, 30};
-  int cap = borrow_cap(later, rule);
-  for (int chunk; (chunk = chunk_to_borrow(75, cap, later, rule)) > 0;) {
-    lend(later, chunk, rule);
-    cap -= chunk;
-    window += chunk;
-  }
-  EXPECT_EQ(window, 187);
-  EXPECT_EQ(window + sum(later), 300);
-  for (int m : later) EXPECT_GE(m, rule.floor_per_stage);
+  std::vector<int> limits{75, 30, 30, 75, 30, 30, 30};
+  StageBorrowing first(limits, 0, rule);
+  EXPECT_EQ(first.next(limits), 75);
+  EXPECT_EQ(first.next(limits), 37);
+  EXPECT_EQ(first.next(limits), 0);
+  EXPECT_EQ(first.borrowed(), 112);
+  EXPECT_EQ(limits[0], 187);
+  EXPECT_EQ(sum(limits), 300);
+  for (size_t k = 1; k < limits.size(); ++k) EXPECT_GE(limits[k], rule.floor_per_stage);
+  // A later window borrows only from the stages after it.
+  std::vector<int> plan{75, 30, 30, 75, 30, 30, 30};
+  StageBorrowing fourth(plan, 3, rule);
+  EXPECT_EQ(fourth.next(plan), 45);  // half of the 90 after it
+  EXPECT_EQ((std::vector<int>(plan.begin(), plan.begin() + 3)), (std::vector<int>{75, 30, 30}));
+  EXPECT_EQ(plan[3], 120);
+  EXPECT_EQ(sum(plan), 300);
+  EXPECT_EQ(fourth.next(plan), 0);
+  // The last stage has no one to borrow from.
+  StageBorrowing last(plan, plan.size() - 1, rule);
+  EXPECT_EQ(last.next(plan), 0);
+  EXPECT_EQ(sum(plan), 300);
 }
 
 }  // namespace
