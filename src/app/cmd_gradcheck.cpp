@@ -24,7 +24,7 @@ struct GradcheckCommandOptions {
   std::string scene;
   int samples = 40, frames = 0, substeps = 0;
   double eps = 1e-4, dt = 0, perturb = 0.1, kink_tolerance = 1e-2;
-  std::string solver = "direct";
+  std::string solver;  // empty: "scene" with --at (the run's own objective), "direct" otherwise
   unsigned seed = 7;
   std::string adjoint;
   std::string at;  // a run directory whose controls.bin the check is made at
@@ -36,7 +36,8 @@ Scene gradcheck_scene(const GradcheckCommandOptions& o) {
   Scene scene = shortened(load_scene(o.scene), o.frames);
   if (o.substeps > 0) scene.time.substeps = o.substeps;
   if (!o.adjoint.empty()) scene.optimizer.adjoint = adjoint_kind(o.adjoint);
-  if (scene.cloth && o.solver == "direct") scene.cloth->solver = "direct";
+  const std::string solver = !o.solver.empty() ? o.solver : o.at.empty() ? "direct" : "scene";
+  if (scene.cloth && solver == "direct") scene.cloth->solver = "direct";
   if (o.dt > 0) {
     const double n = 1.0 / (scene.time.fps * o.dt);
     if (std::abs(n - std::round(n)) > 1e-6 || std::round(n) < 1)
@@ -118,9 +119,9 @@ void add_gradcheck_options(CLI::App* sub, const std::shared_ptr<GradcheckCommand
   sub->add_option("--solver", o->solver,
                   "cloth: the steps' linear solve during the check: direct (exact to round-off: differences of "
                   "an iteratively solved step jitter with its convergence test and measure the solver, not the "
-                  "adjoint) or scene (the scene's cloth.solver and cg_tolerance)")
-      ->check(CLI::IsMember({"direct", "scene"}))
-      ->capture_default_str();
+                  "adjoint) or scene (the scene's cloth.solver and cg_tolerance); default: scene with --at (the run's "
+                  "own objective), direct otherwise")
+      ->check(CLI::IsMember({"direct", "scene"}));
   sub->add_option("--frames", o->frames, "shorten the scene to this many frames (keyframes move proportionally)")
       ->check(CLI::Range(1, 1000000));
   sub->add_option("--substeps", o->substeps, "override the integrator steps per frame")->check(CLI::Range(1, 100000));

@@ -119,7 +119,7 @@ TEST_F(ScheduleReplayCli, ResumedFromControlsItStartsAtTheRunsFinalObjective) {
 TEST_F(ScheduleReplayCli, GradcheckAtARunChecksAtTheRunsOwnObjective) {
   const auto phi_at = [&](const std::string& run, std::string* output) {
     const std::string cmd = "cd '" + dir_.string() + "' && '" KEYFRAME_BINARY "' gradcheck " + run +
-                            "/scene.json --at " + run + " --solver scene --samples 2 2>err.txt";
+                            "/scene.json --at " + run + " --samples 2 2>err.txt";
     FILE* p = popen(cmd.c_str(), "r");
     std::string out;
     char buf[4096];
