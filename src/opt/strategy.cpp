@@ -409,8 +409,9 @@ void run_stage(Run& run, std::vector<StageSpec>& stages, size_t s) {
 }
 
 // Runs stages[first], stages[first + 1], ...: a stage that converged or stalled early leaves its unspent
-// evaluations to the next (unless every stage has a fixed budget). A window that met the keyframes it is
-// judged on skips the longer windows of the same keyframes.
+// evaluations to the next, and one stopped by its limit while still falling borrows from those after it
+// (run_stage; neither when every stage has a fixed budget). A window that met the keyframes it is judged on
+// skips the longer windows of the same keyframes.
 void run_stages(Run& run, std::vector<StageSpec>& stages, size_t first) {
   for (size_t s = first;
        s < stages.size() && !run.r.interrupted && run.r.reason != StopReason::kKeyframesReached; ++s) {
