@@ -1,7 +1,8 @@
 // A window still descending at its limit goes on (opt/window_extension.h), through `keyframe optimize`'s job on
 // the generated suite's drop-collider-9 (a sheet dropped onto a sphere with friction, keyframes at frames 17 and
 // 35), whose first window stops at its planned share still falling: it borrows from the stages after it, its
-// best objective falls below what it had at its share, and the run spends no more than its budget.
+// best objective falls below what it had at its share, and the run spends no more than its budget. A run cut in
+// the borrowed evaluations and resumed ends with the same controls as one never cut.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,9 +15,12 @@
 #include <string>
 
 #include "app/optimize_job.h"
+#include "core/error.h"
 #include "opt/windows.h"
 #include "scene/scene.h"
+#include "../reliability/cli_harness.h"
 #include "../sim/character_test_util.h"
+#include "../support/interrupted_run.h"
 
 namespace kf {
 namespace {
@@ -47,16 +51,14 @@ double best_of_first_stage(const std::filesystem::path& csv, int n) {
   return best;
 }
 
-TEST(WindowExtensionJob, AFirstWindowStillFallingAtItsShareBorrowsAndEndsLower) {
+TEST(WindowExtensionJob, AFirstWindowStillFallingAtItsShareBorrowsEndsLowerAndResumesAsIfNeverCut) {
   const Scene scene = load_scene(kScene);
   const StagePlan plan = plan_stages(scene);
   ASSERT_GT(plan.stages.size(), 2u);
   const int share = plan.stages.front().max_evaluations;
   test::TempDir dir;
-  OptimizeOptions opt;
-  opt.quiet = true;
-  opt.out = (dir.path() / "run").string();
-  optimize_job(kScene, opt);
+  const int whole_code = test::run_keyframe_interrupted(dir.path(), {"optimize", kScene.string(), "--out", "run"});
+  EXPECT_EQ(whole_code, kExitNotReached);
   std::ifstream in(dir.path() / "run" / "report.json");
   const json report = json::parse(in);
   const json& first = report.at("stage_results").at(0);
@@ -70,6 +72,16 @@ TEST(WindowExtensionJob, AFirstWindowStillFallingAtItsShareBorrowsAndEndsLower) 
   EXPECT_NE(log.find("borrowed from the stages after it"), std::string::npos);
   std::printf("drop-collider-9: first window %d evaluations (share %d), objective %.4g (%.4g at its share)\n",
               first_evaluations, share, first.at("objective_end").get<double>(), at_share);
+
+  // Cut half way through the first borrowed chunk, then resumed: the tape replays the evaluations and the rule
+  // decides again from them.
+  const int cut_after = share + share / 2;
+  ASSERT_LT(cut_after, first_evaluations);
+  EXPECT_EQ(test::run_keyframe_interrupted(dir.path(), {"optimize", kScene.string(), "--out", "cut"}, cut_after),
+            kExitInterrupted);
+  EXPECT_EQ(test::run_keyframe_interrupted(dir.path(), {"optimize", "--resume", "cut"}), whole_code);
+  EXPECT_EQ(reliability::read_text(dir.path() / "cut" / "controls.bin"),
+            reliability::read_text(dir.path() / "run" / "controls.bin"));
 }
 
 }  // namespace
