@@ -61,6 +61,7 @@ class CapeSystem final : public System {
   Character& character() { return character_; }
   ClothSystem& cloth() { return *cloth_; }
   const SelfCollider& self_collider() const { return *self_; }
+  const BodyCollider& body_collider() const { return *body_; }
 
  private:
   void prepare(int n, const VecX& x, const VecX& v);  // body at step n (and its velocity), self hash of x, v
