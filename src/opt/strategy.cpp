@@ -15,7 +15,6 @@
 #include "opt/term_breakdown.h"
 #include "opt/throw_fit.h"
 #include "opt/uncontrolled_floor.h"
-#include "opt/window_extension.h"
 #include "sim/make_system.h"
 
 namespace kf {
@@ -309,57 +308,8 @@ std::unique_ptr<System> stage_system(const Run& run, size_t s, double h) {
   return scale == 1.0 ? run.hooks.make_system(h) : make_system(with_friction_scaled(run.scene, scale), h);
 }
 
-// A stage that is not the last, stopped by its limit while still falling, goes on from its best point with
-// evaluations borrowed from the stages after it (opt/window_extension.h); `res` becomes the whole stage's.
-void go_on_while_falling(Run& run, std::vector<StageSpec>& stages, size_t s, OptimizerSpec spec,
-                         const RestartHooks& hooks, OptimizeResult& res) {
-  const WindowExtensionRule rule;
-  if (!rule.on || run.fixed_budgets || s + 1 >= stages.size()) return;
-  std::vector<int> limits;
-  for (const StageSpec& st : stages) limits.push_back(st.max_evaluations);
-  limits[s] = spec.max_evaluations;  // its own share (less Gauss-Newton's passes, on a large thrown sheet)
-  StageBorrowing borrowing(limits, s, rule);
-  while (!res.interrupted && !(run.stop && run.stop->load()) &&
-         still_falling_at_limit(res.reason, res.history, rule)) {
-    const int chunk = borrowing.next(limits);
-    if (chunk == 0) return;
-    stages[s].max_evaluations += chunk;
-    for (size_t k = s + 1; k < stages.size(); ++k) stages[k].max_evaluations = limits[k];
-    std::ostringstream os;
-    os << std::setprecision(3) << "still falling at its limit (x" << last_tenth_ratio(res.history)
-       << " over its last tenth): " << chunk << " more evaluations, borrowed from the stages after it";
-    run.log.say(os.str());
-    const int used = int(res.history.size());
-    const double before = res.seconds;
-    RestartHooks more_hooks = hooks;
-    if (hooks.on_eval)
-      more_hooks.on_eval = [&hooks, used, before](const EvaluationRecord& e0) {
-        EvaluationRecord e = e0;
-        e.evaluation += used;
-        e.seconds += before;
-        hooks.on_eval(e);
-      };
-    spec.max_evaluations = chunk;
-    OptimizeResult more =
-        minimize_with_restarts(*run.r.problem, spec, run.scene.optimizer.restarts, res.z, more_hooks, run.stop, run.r.tape);
-    more.seconds += before;
-    more.evaluations += res.evaluations;
-    more.capped_trials += res.capped_trials;
-    for (EvaluationRecord& e : more.history) {
-      e.evaluation += used;
-      e.seconds += before;
-    }
-    more.history.insert(more.history.begin(), res.history.begin(), res.history.end());
-    if (!(more.phi < res.phi)) {  // no progress: the earlier best point stands
-      more.z = res.z;
-      more.phi = res.phi;
-    }
-    res = std::move(more);
-  }
-}
-
 // Stage s of the plan: its system (the first is built already), problem and optimisation.
-void run_stage(Run& run, std::vector<StageSpec>& stages, size_t s) {
+void run_stage(Run& run, const std::vector<StageSpec>& stages, size_t s) {
   StrategyResult& r = run.r;
   r.time.substeps = stages[s].substeps;
   const bool friction_changed = s > 0 && friction_scale(run, s) != friction_scale(run, s - 1);
@@ -401,17 +351,16 @@ void run_stage(Run& run, std::vector<StageSpec>& stages, size_t s) {
   if (r.hold_splits) hooks.before_restart = [&](const VecX& z, double& phi) { return rehold_schedule(r, z, phi); };
   hooks.reached = keyframes_reached(run, problem, judged_until(run, s));
   run.log.stage_started(spec.max_evaluations);
-  OptimizeResult res = minimize_with_restarts(problem, spec, run.scene.optimizer.restarts, r.z, hooks, run.stop, r.tape);
-  go_on_while_falling(run, stages, s, spec, hooks, res);
+  const OptimizeResult res =
+      minimize_with_restarts(problem, spec, run.scene.optimizer.restarts, r.z, hooks, run.stop, r.tape);
   run.log.stage_finished();
   record_stage(run, res);
   run.stage_ends.push_back(as_scene_controls(run, res.z));
 }
 
 // Runs stages[first], stages[first + 1], ...: a stage that converged or stalled early leaves its unspent
-// evaluations to the next, and one stopped by its limit while still falling borrows from those after it
-// (run_stage; neither when every stage has a fixed budget). A window that met the keyframes it is judged on
-// skips the longer windows of the same keyframes.
+// evaluations to the next (unless every stage has a fixed budget). A window that met the keyframes it is
+// judged on skips the longer windows of the same keyframes.
 void run_stages(Run& run, std::vector<StageSpec>& stages, size_t first) {
   for (size_t s = first;
        s < stages.size() && !run.r.interrupted && run.r.reason != StopReason::kKeyframesReached; ++s) {
