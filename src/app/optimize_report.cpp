@@ -46,6 +46,7 @@ RunFacts run_facts(const StrategyResult& run, const std::vector<HistoryRow>& his
   RunFacts f;
   f.status = run.status;
   f.budget = budget_spent(run.reason);
+  f.scaled_budget = run.scaled_budget;
   f.fallback = run.fallback;
   if (history.empty()) return f;
   f.objective_start = history.front().rec.phi;
@@ -146,6 +147,7 @@ void diagnose_run(const Scene& scene, OptimizeRun& run, const EvaluationLog& elo
       measure_sensitivity(scene, job.time, problem.checkpoint_every(), problem.memory_budget());
   RunFacts facts = run_facts(job, elog.history());
   facts.flock = scene.flock.has_value();
+  facts.max_evaluations = scene.optimizer.max_evaluations;
   facts.keyframe_objective_start = before.keyframes;
   facts.keyframe_objective_end = final_keyframes;
   facts.effort_end = effort_end;

@@ -361,7 +361,12 @@ Diagnosis diagnose(const std::vector<KeyframeJudgement>& keyframes, const Sensit
   d.reached = !worst || worst->miss_after <= 1.0;
   d.far = worst && worst->miss_after > kFarMiss;
   d.progress = facts.keyframe_objective_end <= 0.5 * facts.keyframe_objective_start;
-  const std::string budget = facts.budget ? " (it stopped at its budget: " + facts.status + ")" : "";
+  const std::string budget = !facts.budget ? ""
+                             : facts.scaled_budget > 0
+                                 ? format(" (it stopped at the %.0f of its %.0f evaluations its plan gives a flight this large: ",
+                                          facts.scaled_budget, facts.max_evaluations) +
+                                       facts.status + ")"
+                                 : " (it stopped at its budget: " + facts.status + ")";
   if (d.reached) {
     d.outcome = "reached";
     d.line = "reached its keyframes" + budget;

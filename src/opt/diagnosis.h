@@ -93,6 +93,8 @@ DescentProbe probe_descent(Problem& problem, const VecX& z);
 struct RunFacts {
   std::string status;                // why the last stage stopped
   bool budget = false;               // it stopped at an evaluation or time limit
+  int scaled_budget = 0;             // a large flight's plan: the evaluations it gave (0: optimizer.max_evaluations)
+  int max_evaluations = 0;           // optimizer.max_evaluations
   double keyframe_objective_start = 0;  // φ without the effort term, first and best evaluation
   double keyframe_objective_end = 0;
   double effort_end = 0;             // the effort term at the end

@@ -601,6 +601,8 @@ StrategyResult run_strategy(StrategySetup setup, const StrategyHooks& hooks, Str
   if (r.problem) r.problem->set_weight_scales({});
   keep_no_worse_than_uncontrolled(run);
   r.planned_stages = int(stages.size());
+  // Every stage its own budget, or only the last stage continued from controls.bin: not the plan's share.
+  if (!run.fixed_budgets && !run.from_controls) r.scaled_budget = setup.plan.scaled_budget;
   return std::move(run.r);
 }
 

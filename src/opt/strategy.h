@@ -93,6 +93,7 @@ struct StrategyResult {
   double seconds = 0;
   std::vector<StageOutcome> stages;
   int planned_stages = 0;  // the plan's, with the windows after an early end
+  int scaled_budget = 0;   // StagePlan::scaled_budget
   bool hold_splits = false;  // optimizer.split_schedule "held", on cloth
   StepSchedule schedule;     // the step schedule the last stage held
   // Each keyframe's weight over the scene's in the last stage (empty: the scene's); the result's problem is

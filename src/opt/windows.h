@@ -55,6 +55,8 @@ struct StagePlan {
   // whole horizon may settle on forces far costlier than windows find (a flag released in its plane).
   bool windows_on_early_end = false;
   std::string why;                // one line: the plan and what chose it
+  // A large flight's stages share fewer evaluations than optimizer.max_evaluations: how many (0: not scaled).
+  int scaled_budget = 0;
 };
 
 // The stages of `scene`. Measuring the growth costs one simulation and its adjoint pass.

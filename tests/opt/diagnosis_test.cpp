@@ -260,6 +260,25 @@ TEST(Diagnosis, ABudgetStopStatesTheEvaluationsItExpectsToNeed) {
   EXPECT_NE(line.find("needs about 24 more"), std::string::npos) << line;
 }
 
+// A large flight's plan spends fewer evaluations than optimizer.max_evaluations: its stop says so, not "its budget".
+TEST(Diagnosis, ALargeFlightsBudgetStopNamesThePlansShare) {
+  Sensitivity s;
+  s.growth = s.growth_beyond_free = 1.5;
+  RunFacts f = facts(10, 9, "evaluation limit reached");
+  f.evaluations = 69;
+  f.recent_improvement = 0.5;
+  f.max_evaluations = 300;
+  const std::string plain = diagnose(one_keyframe(15, 4), s, f).line;
+  EXPECT_NE(plain.find("(it stopped at its budget: evaluation limit reached)"), std::string::npos) << plain;
+  f.scaled_budget = 69;
+  const std::string line = diagnose(one_keyframe(15, 4), s, f).line;
+  EXPECT_NE(line.find("(it stopped at the 69 of its 300 evaluations its plan gives a flight this large: evaluation "
+                      "limit reached)"),
+            std::string::npos)
+      << line;
+  EXPECT_EQ(line.find("its budget:"), std::string::npos) << line;
+}
+
 TEST(Diagnosis, ARunThatFellBackBelowItsResultSaysWhere) {
   Sensitivity s;
   s.growth = s.growth_beyond_free = 1.5;

@@ -48,6 +48,7 @@ TEST(ThrowLargeSheet, ThePlanSpendsFewerEvaluationsWhenAFlightIsDear) {
   // A 12 x 12 sheet over 30 steps (4320 particle-steps): the whole budget, as before.
   const StagePlan small = plan_stages(thrown_scene(12, 30));
   EXPECT_EQ(planned(small), 300);
+  EXPECT_EQ(small.scaled_budget, 0);
   EXPECT_EQ(small.stages[0].max_evaluations, 40);
   EXPECT_EQ(small.stages[1].max_evaluations, 60);
   // A 26 x 26 sheet over 30 steps (20280): 300 × (12000 / 20280)^1.5 = 136.5 of them, the rigid stage still 40.
@@ -55,6 +56,7 @@ TEST(ThrowLargeSheet, ThePlanSpendsFewerEvaluationsWhenAFlightIsDear) {
   const StagePlan large = plan_stages(thrown_scene(26, 30));
   ASSERT_EQ(large.stages.size(), 3u);
   EXPECT_EQ(planned(large), 137);
+  EXPECT_EQ(large.scaled_budget, 137);  // what a budget stop names
   EXPECT_EQ(large.stages[0].max_evaluations, 40);
   EXPECT_EQ(large.stages[1].max_evaluations, 32);
   EXPECT_EQ(large.stages[2].max_evaluations, 65);
