@@ -237,11 +237,12 @@ void plan_throw(const Scene& scene, StagePlan& plan) {
   plan.why = "stages: a search over " + std::to_string(plan.throw_search) +
              " rigid throws, the best rigid throw (6 variables), a 3 x 3 lattice of initial velocities over the "
              "sheet from it, then one initial velocity per particle";
-  if (budget < o.max_evaluations) plan.scaled_budget = budget;
-  if (budget < o.max_evaluations)
+  if (budget < o.max_evaluations) {
+    plan.scaled_budget = budget;
     plan.why += " (" + std::to_string(budget) + " of the " + std::to_string(o.max_evaluations) +
                 " evaluations: a flight of " + std::to_string(scene.cloth->particles() * scene.time.steps()) +
                 " particle-steps)";
+  }
   plan.scaled_first_step = true;
 }
 
