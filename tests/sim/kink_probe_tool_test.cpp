@@ -217,18 +217,24 @@ nlohmann::json zones(const RolloutState& s) {
   return j;
 }
 
-TEST(KinkProbeTool, DISABLED_Measure) {
-  const char* file = std::getenv("KF_KINK_SCENE");
-  const char* run = std::getenv("KF_KINK_RUN");
-  const char* out = std::getenv("KF_KINK_OUT");
-  ASSERT_TRUE(file && run && out);
-  auto env = [](const char* k, double d) { return std::getenv(k) ? std::atof(std::getenv(k)) : d; };
+// The scene a probe runs: KF_KINK_SOLVER "direct", KF_KINK_RAMP and KF_KINK_STIFFNESS override its keys.
+Scene probe_scene(const char* file) {
   Scene scene = load_scene(file);
   const std::string solver = std::getenv("KF_KINK_SOLVER") ? std::getenv("KF_KINK_SOLVER") : "scene";
   if (solver == "direct") scene.cloth->solver = "direct";
   if (std::getenv("KF_KINK_RAMP")) scene.cloth->contact_ramp = std::atof(std::getenv("KF_KINK_RAMP"));
   if (std::getenv("KF_KINK_STIFFNESS")) scene.character->body_stiffness = std::atof(std::getenv("KF_KINK_STIFFNESS"));
   resolve_uncontrolled_offsets(scene);
+  return scene;
+}
+
+TEST(KinkProbeTool, DISABLED_Measure) {
+  const char* file = std::getenv("KF_KINK_SCENE");
+  const char* run = std::getenv("KF_KINK_RUN");
+  const char* out = std::getenv("KF_KINK_OUT");
+  ASSERT_TRUE(file && run && out);
+  auto env = [](const char* k, double d) { return std::getenv(k) ? std::atof(std::getenv(k)) : d; };
+  Scene scene = probe_scene(file);
   ASSERT_TRUE(scene.character.has_value());
   auto made = make_system(scene, scene.time.h());
   auto* cape = dynamic_cast<CapeSystem*>(made.get());
@@ -329,12 +335,7 @@ TEST(KinkProbeTool, DISABLED_Nonlinearity) {
   const char* run = std::getenv("KF_KINK_RUN");
   const char* out = std::getenv("KF_KINK_OUT");
   ASSERT_TRUE(file && run && out);
-  Scene scene = load_scene(file);
-  const std::string solver = std::getenv("KF_KINK_SOLVER") ? std::getenv("KF_KINK_SOLVER") : "scene";
-  if (solver == "direct") scene.cloth->solver = "direct";
-  if (std::getenv("KF_KINK_RAMP")) scene.cloth->contact_ramp = std::atof(std::getenv("KF_KINK_RAMP"));
-  if (std::getenv("KF_KINK_STIFFNESS")) scene.character->body_stiffness = std::atof(std::getenv("KF_KINK_STIFFNESS"));
-  resolve_uncontrolled_offsets(scene);
+  Scene scene = probe_scene(file);
   auto made = make_system(scene, scene.time.h());
   auto* cape = dynamic_cast<CapeSystem*>(made.get());
   ASSERT_NE(cape, nullptr);
