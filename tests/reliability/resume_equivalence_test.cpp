@@ -8,6 +8,7 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 
+#include "../support/interrupted_run.h"
 #include "app/optimize_job.h"
 #include "cli_harness.h"
 #include "core/error.h"
@@ -17,35 +18,18 @@ namespace {
 
 // Runs keyframe ARGS in `cwd`; after `signal_after` evaluation lines on stdout, sends `sig` (0: never).
 int run_and_signal(const fs::path& cwd, const std::vector<std::string>& args, int signal_after = 0, int sig = SIGINT) {
-  int fds[2];
-  EXPECT_EQ(::pipe(fds), 0);
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    ::dup2(fds[1], STDOUT_FILENO);
-    ::close(fds[0]);
-    if (::chdir(cwd.c_str()) != 0) ::_exit(120);
-    std::vector<char*> argv{const_cast<char*>(KEYFRAME_BINARY)};
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    ::execv(KEYFRAME_BINARY, argv.data());
-    ::_exit(127);
-  }
-  ::close(fds[1]);
-  FILE* out = ::fdopen(fds[0], "r");
+  test::KeyframeChild child = test::start_keyframe(cwd, args);
   char line[4096];
   int evals = 0;
   bool signalled = false;
-  while (std::fgets(line, sizeof line, out)) {
+  while (std::fgets(line, sizeof line, child.out)) {
     const std::string s(line);
     if (s.rfind("eval ", 0) == 0 || s.find(" eval ") != std::string::npos) ++evals;
     // Once: lines printed after it (the interruption's own) must not signal again, when the run may have
     // left its handler and a second signal would kill it.
-    if (signal_after > 0 && evals == signal_after && !signalled) signalled = ::kill(pid, sig) == 0;
+    if (signal_after > 0 && evals == signal_after && !signalled) signalled = ::kill(child.pid, sig) == 0;
   }
-  std::fclose(out);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return test::wait_for(child);
 }
 
 nlohmann::json report_of(const fs::path& run) { return nlohmann::json::parse(read_text(run / "report.json")); }

@@ -15,6 +15,7 @@
 #include <thread>
 #include <tuple>
 
+#include "../support/interrupted_run.h"
 #include "app/optimize_job.h"
 #include "cli_harness.h"
 #include "core/error.h"
@@ -40,37 +41,21 @@ bool catches(pid_t pid, int sig) {
 // `when_handled`, as soon as the run has its handler for it, sends `sig` once.
 Signalled run_and_signal(const fs::path& cwd, const std::vector<std::string>& args, const std::string& trigger = {},
                          int sig = SIGINT, bool when_handled = false) {
-  int fds[2];
-  EXPECT_EQ(::pipe(fds), 0);
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    ::dup2(fds[1], STDOUT_FILENO);
-    ::close(fds[0]);
-    if (::chdir(cwd.c_str()) != 0) ::_exit(120);
-    std::vector<char*> argv{const_cast<char*>(KEYFRAME_BINARY)};
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    ::execv(KEYFRAME_BINARY, argv.data());
-    ::_exit(127);
-  }
-  ::close(fds[1]);
+  test::KeyframeChild child = test::start_keyframe(cwd, args);
+  const pid_t pid = child.pid;
   if (when_handled) {  // as soon as the process catches `sig` (its handler is installed), not before
     for (int k = 0; k < 20000 && !catches(pid, sig); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     ::kill(pid, sig);
   }
-  FILE* out = ::fdopen(fds[0], "r");
   char line[8192];
   Signalled r;
   bool signalled = false;
-  while (std::fgets(line, sizeof line, out)) {
+  while (std::fgets(line, sizeof line, child.out)) {
     const std::string s(line);
     r.output += s;
     if (!trigger.empty() && !signalled && s.rfind(trigger, 0) == 0) signalled = ::kill(pid, sig) == 0;
   }
-  std::fclose(out);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.code = test::wait_for(child);
   return r;
 }
 
