@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/optimize_job.h"
+#include "../support/reachable_classes.h"
 #include "bench/bench_reachable.h"
 #include "../sim/character_test_util.h"
 
@@ -74,29 +75,16 @@ TEST(ReachableCapeScenes, AnEarlyKeyframeIsMetBeforeTheLastOne) {
   EXPECT_GT(early->at("miss_before").get<double>(), 1.0) << "the early keyframe was met uncontrolled";
 }
 
-// The classes without and with a character (Embree's queries run untrapped: tests/test_main.cpp).
-std::vector<std::string> classes(bool character) {
-  std::vector<std::string> v;
-  for (const std::string& c : reachable_classes())
-    if ((c.rfind("cape", 0) == 0) == character) v.push_back(c);
-  return v;
-}
-
-std::string test_name(const testing::TestParamInfo<std::string>& info) {
-  std::string s = info.param;
-  for (char& c : s)
-    if (c == '-') c = '_';
-  return s;
-}
-
 class ReachableReduced : public testing::TestWithParam<std::string> {};
 class ReachableCapeReduced : public testing::TestWithParam<std::string> {};
 
 TEST_P(ReachableReduced, MeetsEveryKeyframeAtDefaults) { expect_reduced_scene_meets_its_keyframes(GetParam()); }
 TEST_P(ReachableCapeReduced, MeetsEveryKeyframeAtDefaults) { expect_reduced_scene_meets_its_keyframes(GetParam()); }
 
-INSTANTIATE_TEST_SUITE_P(Generated, ReachableReduced, testing::ValuesIn(classes(false)), test_name);
-INSTANTIATE_TEST_SUITE_P(Generated, ReachableCapeReduced, testing::ValuesIn(classes(true)), test_name);
+INSTANTIATE_TEST_SUITE_P(Generated, ReachableReduced, testing::ValuesIn(test::reachable_classes_with_character(false)),
+                         test::class_test_name);
+INSTANTIATE_TEST_SUITE_P(Generated, ReachableCapeReduced, testing::ValuesIn(test::reachable_classes_with_character(true)),
+                         test::class_test_name);
 
 }  // namespace
 }  // namespace kf

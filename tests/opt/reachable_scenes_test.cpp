@@ -6,6 +6,7 @@
 #include <fstream>
 #include <set>
 
+#include "../support/reachable_classes.h"
 #include "bench/bench_reachable.h"
 #include "adjoint/rollout.h"
 #include "opt/problem.h"
@@ -42,21 +43,6 @@ double keyframe_terms(const Problem& problem) {
   return s;
 }
 
-// The classes without and with a character (Embree's queries run untrapped: tests/test_main.cpp).
-std::vector<std::string> classes(bool character) {
-  std::vector<std::string> v;
-  for (const std::string& c : reachable_classes())
-    if ((c.rfind("cape", 0) == 0) == character) v.push_back(c);
-  return v;
-}
-
-std::string test_name(const testing::TestParamInfo<std::string>& info) {
-  std::string s = info.param;
-  for (char& c : s)
-    if (c == '-') c = '_';
-  return s;
-}
-
 void expect_variant_controls_meet_the_keyframes(const std::string& kind) {
   for (int index = 0; index < 4; ++index) {
     SCOPED_TRACE(kind + "-" + std::to_string(index));
@@ -84,8 +70,10 @@ TEST_P(ReachableCapeClass, VariantControlsMeetEveryKeyframeTheUncontrolledSceneM
   expect_variant_controls_meet_the_keyframes(GetParam());
 }
 
-INSTANTIATE_TEST_SUITE_P(Generated, ReachableClass, testing::ValuesIn(classes(false)), test_name);
-INSTANTIATE_TEST_SUITE_P(Generated, ReachableCapeClass, testing::ValuesIn(classes(true)), test_name);
+INSTANTIATE_TEST_SUITE_P(Generated, ReachableClass, testing::ValuesIn(test::reachable_classes_with_character(false)),
+                         test::class_test_name);
+INSTANTIATE_TEST_SUITE_P(Generated, ReachableCapeClass, testing::ValuesIn(test::reachable_classes_with_character(true)),
+                         test::class_test_name);
 
 // Forces m dg on every particle move a sheet as its gravity tilted by dg does (what the variant stands for).
 void expect_forces_match_tilted_gravity(const std::vector<std::string>& kinds) {

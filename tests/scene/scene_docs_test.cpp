@@ -18,6 +18,7 @@
 
 #include <unistd.h>
 
+#include "../reliability/cli_harness.h"
 #include "scene/params.h"
 #include "scene/scene.h"
 #include "scene/scene_schema.h"
@@ -29,12 +30,7 @@ namespace fs = std::filesystem;
 
 const fs::path kSource = KEYFRAME_SOURCE_DIR;
 
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
+using reliability::read_text;
 
 // Every key read (JSON pointers with array indices) over the example scenes the schema is generated from
 // (src/scene/scene_schema.h), which enter every branch of the parser.

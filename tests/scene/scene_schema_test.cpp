@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "../reliability/cli_harness.h"
 #include "scene/params.h"
 #include "scene/scene.h"
 #include "scene/scene_schema.h"
@@ -27,12 +28,7 @@ namespace fs = std::filesystem;
 
 const fs::path kSource = KEYFRAME_SOURCE_DIR;
 
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
+using reliability::read_text;
 
 bool has_type(const Json& v, const std::string& type) {
   if (type == "object") return v.is_object();
