@@ -174,7 +174,8 @@ ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int coun
   const int searched = rigid.reached() ? 0 : std::max(0, std::min(count - rigid.simulated, budget - spent));
   ThrowSearch s = search_throws(problem, searched, fitted, stop, &scene);
   s.simulated += rigid.simulated;
-  if (!rigid.reached() && !s.met) {
+  constexpr double kMet = 0.5;  // a fit within half of every tolerance, as the search's early end: no other start
+  if (!rigid.reached() && !s.met && !(rigid.z.size() == 6 && rigid.worst_miss <= kMet)) {
     const auto fitted_from = [&](const VecX& z) {
       return std::any_of(starts.begin(), starts.end(), [&](const VecX& a) { return a == z; });
     };
@@ -185,15 +186,17 @@ ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int coun
       for (const VecX& z : s.best_throws)
         if (!fitted_from(z)) more_starts.push_back(z);
     }
-    // As the search: a throw within half of every tolerance needs no other start.
-    if (more_starts.size() > 1) o.reach_share = 0.5;
+    if (more_starts.size() > 1) o.reach_share = kMet;
     for (size_t k = 0; k < more_starts.size(); ++k) {
-      o.max_simulations = std::clamp((budget - s.simulated) / int(more_starts.size() - k), 0, quarter);
+      // The search's best, when it beats the scene's and the fitted throw, keeps its quarter; the others share
+      // what is left evenly.
+      const int left = budget - s.simulated;
+      o.max_simulations = std::clamp(k == 0 && more_starts[0] == s.z ? left : left / int(more_starts.size() - k), 0, quarter);
       if (o.max_simulations == 0) break;
       const RigidThrowFit more = fit_rigid_throw(problem, scene, {more_starts[k]}, o);
       s.simulated += more.simulated;
       absorb(rigid, more);
-      if (more.reached()) break;
+      if (more.reached() || (more.z.size() == 6 && more.worst_miss <= kMet)) break;
     }
   }
   if (rigid.z.size() == 6) {
