@@ -57,7 +57,9 @@ ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted
 // alone, as its time allows). A flight that lands on a collider or the ground is a rough function of the
 // throw: the search's best often lies in another basin than the keyframes', and a runner-up in theirs
 // (generated throw-0: its third best). Each fit flies at most a quarter of `count` (at most 100 the first);
-// `budget` caps every flight together, the fits from the best throws sharing what is left of it evenly.
+// `budget` caps every flight together. The search's best, when it beats the scene's and the fitted throw,
+// has its quarter as the one start it was; the other best throws share what is left evenly. A fit already
+// within half of every tolerance ends it.
 // The result's z is the best point of all, by φ.
 ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int count, int budget,
                                   const std::atomic<bool>* stop = nullptr);
