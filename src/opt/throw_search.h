@@ -27,7 +27,7 @@ struct ThrowSearch {
   std::vector<VecX> best_throws;       // the search's own best few throws (kFitStarts at most), lowest φ first
 };
 
-// The fit after the search starts from this many of its best throws (one on a large flight, opt/windows.h).
+// The fit after the search starts from this many of its best throws (one on a flight beyond kLargeFlight).
 constexpr int kFitStarts = 4;
 
 // A flight of more particle-steps than this is a large sheet's: the plan spends fewer evaluations on it.
