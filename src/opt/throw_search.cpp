@@ -1,6 +1,7 @@
 #include "opt/throw_search.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -60,6 +61,39 @@ class MeetsKeyframes {
   double reach_ = 0;
 };
 
+namespace {
+
+// The kFitStarts lowest-φ throws offered, kept in fixed storage: the search offers every throw it flies.
+class BestThrows {
+ public:
+  BestThrows() {
+    for (VecX& z : z_) z = VecX::Zero(6);
+    phi_.fill(INFINITY);
+  }
+  void offer(double phi, const VecX& z) {
+    int k = n_ < kFitStarts ? n_++ : kFitStarts - 1;  // the slot it may take: a free one, or the worst
+    if (!(phi < phi_[size_t(k)])) return;
+    for (; k > 0 && phi < phi_[size_t(k - 1)]; --k) {
+      phi_[size_t(k)] = phi_[size_t(k - 1)];
+      z_[size_t(k)] = z_[size_t(k - 1)];
+    }
+    phi_[size_t(k)] = phi;
+    z_[size_t(k)] = z;
+  }
+  std::vector<VecX> sorted() const {
+    std::vector<VecX> out;
+    for (int k = 0; k < n_ && std::isfinite(phi_[size_t(k)]); ++k) out.push_back(z_[size_t(k)]);
+    return out;
+  }
+
+ private:
+  std::array<double, kFitStarts> phi_;
+  std::array<VecX, kFitStarts> z_;
+  int n_ = 0;
+};
+
+}  // namespace
+
 ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted, const std::atomic<bool>* stop,
                           const Scene* scene) {
   if (problem.controls().kind() != ControlKind::kInitialRigidVelocity)
@@ -78,6 +112,7 @@ ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted
   for (int i = 0; i < p; ++i) r2 += (x0.segment<3>(3 * i) - centre).squaredNorm();
   const double radius = std::sqrt(r2 / std::max(1, p));
   MeetsKeyframes meets(problem, scene);
+  BestThrows best;
 
   ThrowSearch s;
   s.speed = std::max(1.0, 0.5 * mean_v.norm());
@@ -105,16 +140,19 @@ ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted
       }
       const double phi = problem.evaluate(z, nullptr);
       ++s.simulated;
+      if (!problem.last_diverged()) best.offer(phi, z);
       if (!problem.last_diverged() && phi < s.phi) {
         s.phi = phi;
         s.z = z;
         if (meets(problem)) {  // the rigid stage starts at the keyframes: no throw left to beat it
           s.met = true;
+          s.best_throws = best.sorted();
           return s;
         }
       }
     }
   }
+  s.best_throws = best.sorted();
   return s;
 }
 
@@ -136,11 +174,30 @@ ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int coun
   const int searched = rigid.reached() ? 0 : std::max(0, std::min(count - rigid.simulated, budget - spent));
   ThrowSearch s = search_throws(problem, searched, fitted, stop, &scene);
   s.simulated += rigid.simulated;
-  if (!rigid.reached() && !s.met && s.z.size() == 6 && std::none_of(starts.begin(), starts.end(), [&](const VecX& a) { return a == s.z; })) {
-    o.max_simulations = std::clamp(budget - s.simulated, 0, quarter);
-    const RigidThrowFit more = fit_rigid_throw(problem, scene, {s.z}, o);
-    s.simulated += more.simulated;
-    absorb(rigid, more);
+  constexpr double kMet = 0.5;  // a fit within half of every tolerance, as the search's early end: no other start
+  if (!rigid.reached() && !s.met && !(rigid.z.size() == 6 && rigid.worst_miss <= kMet)) {
+    const auto fitted_from = [&](const VecX& z) {
+      return std::any_of(starts.begin(), starts.end(), [&](const VecX& a) { return a == z; });
+    };
+    std::vector<VecX> more_starts;
+    if (large_flight_share(problem.system().particles(), problem.time().steps()) < 1) {
+      if (s.z.size() == 6 && !fitted_from(s.z)) more_starts.push_back(s.z);
+    } else {
+      for (const VecX& z : s.best_throws)
+        if (!fitted_from(z)) more_starts.push_back(z);
+    }
+    if (more_starts.size() > 1) o.reach_share = kMet;
+    for (size_t k = 0; k < more_starts.size(); ++k) {
+      // The search's best, when it beats the scene's and the fitted throw, keeps its quarter; the others share
+      // what is left evenly.
+      const int left = budget - s.simulated;
+      o.max_simulations = std::clamp(k == 0 && more_starts[0] == s.z ? left : left / int(more_starts.size() - k), 0, quarter);
+      if (o.max_simulations == 0) break;
+      const RigidThrowFit more = fit_rigid_throw(problem, scene, {more_starts[k]}, o);
+      s.simulated += more.simulated;
+      absorb(rigid, more);
+      if (more.reached() || (more.z.size() == 6 && more.worst_miss <= kMet)) break;
+    }
   }
   if (rigid.z.size() == 6) {
     const double phi = problem.evaluate(rigid.z, nullptr);

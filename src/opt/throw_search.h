@@ -24,7 +24,11 @@ struct ThrowSearch {
   double spin = 0;         // and in ω (rad/s)
   bool met = false;        // it ended early at a throw that meets every keyframe within half its tolerance
   std::optional<RigidThrowFit> rigid;  // Levenberg–Marquardt on (Δv, ω) after the search (search_and_fit_throws)
+  std::vector<VecX> best_throws;       // the search's own best few throws (kFitStarts at most), lowest φ first
 };
+
+// The fit after the search starts from this many of its best throws (one on a flight beyond kLargeFlight).
+constexpr int kFitStarts = 4;
 
 // A flight of more particle-steps than this is a large sheet's: the plan spends fewer evaluations on it.
 constexpr double kLargeFlight = 12000;
@@ -48,9 +52,15 @@ ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted
 
 // What runs before a rigid first stage: Levenberg–Marquardt on the six rigid variables (opt/rigid_throw_fit.h)
 // from the scene's throw and the throw fitted to the keyframes; when that does not meet them, the search
-// (`count` throws less the fit's flights) and the fit again from its best. Each fit flies at most a quarter of
-// `count` (at most 100 the first), so all of it takes about the search's time; `budget` caps every flight
-// together. The result's z is the best point of all, by φ.
+// (`count` throws less the fit's flights) and the fit again from each of its kFitStarts best throws, until
+// one is within half of every tolerance (on a flight of more than kLargeFlight particle-steps from its best
+// alone, as its time allows). A flight that lands on a collider or the ground is a rough function of the
+// throw: the search's best often lies in another basin than the keyframes', and a runner-up in theirs
+// (generated throw-0: its third best). Each fit flies at most a quarter of `count` (at most 100 the first);
+// `budget` caps every flight together. The search's best, when it beats the scene's and the fitted throw,
+// has its quarter as the one start it was; the other best throws share what is left evenly. A fit already
+// within half of every tolerance ends it.
+// The result's z is the best point of all, by φ.
 ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int count, int budget,
                                   const std::atomic<bool>* stop = nullptr);
 
