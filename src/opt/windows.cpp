@@ -265,6 +265,7 @@ StagePlan plan_stages(const Scene& scene) {
     return plan;
   }
   if (c.kind != ControlKind::kPerStep && c.kind != ControlKind::kPerFrame) return plan;
+  plan.uniform_push = true;
   const int last = last_keyframe(scene);
   if (last - o.window_frames <= c.from_frame) return plan;  // the whole horizon is one window already
   auto sys = make_system(scene);
