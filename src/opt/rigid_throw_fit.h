@@ -1,30 +1,20 @@
 #pragma once
-// Levenberg–Marquardt on the six rigid throw variables (Δv, ω) of a thrown sheet. A generated throw differs
-// from its scene's by a rigid Δv + ω × r, so an exact rigid solution exists, but the throw search's evenly
-// spread throws only land near it and the rigid stage's L-BFGS, seeing one scalar, crawls along the narrow
-// valley a spin and a velocity make together. A keyframe problem has few residuals (a centre of mass is three
-// numbers) and here six unknowns: their Jacobian by central differences (twelve flights, no adjoint) gives a
-// Gauss–Newton step that reaches a zero-residual solution in a few iterations.
+// Levenberg–Marquardt (opt/few_variable_fit.h) on the six rigid throw variables (Δv, ω) of a thrown sheet. A
+// generated throw differs from its scene's by a rigid Δv + ω × r, so an exact rigid solution exists, but the
+// throw search's evenly spread throws only land near it and the rigid stage's L-BFGS, seeing one scalar, crawls
+// along the narrow valley a spin and a velocity make together; a Jacobian is twelve flights.
 #include <atomic>
 #include <string>
 #include <vector>
 
 #include "core/types.h"
+#include "opt/few_variable_fit.h"
 #include "opt/problem.h"
 #include "scene/scene.h"
 
 namespace kf {
 
-// Why a fit from one start ended.
-enum class RigidFitStop {
-  kReached,      // every placed keyframe within RigidFitOptions::reach_share of its tolerance
-  kConverged,    // a step changed the residuals by (relatively) nothing: a minimum, maybe a local one
-  kStalled,      // the damping grew past any useful step: no step from here lowers the residuals
-  kBudget,       // the simulations allowed were spent
-  kInterrupted,  // *stop was set
-  kNoResiduals,  // no keyframe places the sheet's particles (nothing to fit)
-  kDiverged,     // the start itself diverged
-};
+using RigidFitStop = FitStop;
 
 struct RigidThrowFit {
   VecX z;                   // the best rigid controls (Δv, ω) found over every start
@@ -38,12 +28,8 @@ struct RigidThrowFit {
   bool reached() const { return !stops.empty() && stops.back() == RigidFitStop::kReached; }
 };
 
-struct RigidFitOptions {
-  int max_simulations = 200;
-  // A start is done when every placed keyframe is within this share of its tolerance (0: fit to convergence).
-  double reach_share = 0.01;
-  const std::atomic<bool>* stop = nullptr;  // set: the fit ends after the flight under way
-};
+// The options' scales are set by the fit (a spin times the sheet's radius): leave them empty.
+using RigidFitOptions = FewFitOptions;
 
 // Fits from each of `starts` in turn (rigid controls, 6 numbers each) until one reaches every placed
 // keyframe, the flights allowed are spent or *stop is set; returns the best point of all.

@@ -18,6 +18,7 @@
 #include "opt/optimizer.h"
 #include "opt/problem.h"
 #include "opt/throw_search.h"
+#include "opt/uniform_push.h"
 #include "opt/windows.h"
 #include "scene/scene.h"
 #include "sim/system.h"
@@ -105,6 +106,7 @@ struct StrategyResult {
   std::string fallback;
   std::optional<ThrowSearch> throw_search;  // what the search over rigid throws found
   double throw_seconds = 0;
+  std::optional<UniformPush> uniform_push;  // the push fitted before a sheet's first stage of forces
   // Sets the system's schedule as the result's optimisation saw it (after simulating anything else).
   void hold_result_schedule() {
     if (hold_splits) sys->hold_step_schedule(schedule);

@@ -1,0 +1,53 @@
+#include "opt/uniform_push.h"
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+namespace kf {
+
+VecX uniform_push_controls(Problem& problem, const Vec3& a) {
+  const Controls& c = problem.controls();
+  if (!c.forces()) return {};
+  const VecX& m = problem.system().masses();
+  const long per_block = 3 * m.size();
+  const long blocks = c.per_particle_forces(c.initial_guess()).size() / std::max(1L, per_block);
+  VecX forces(blocks * per_block);
+  for (long b = 0; b < blocks; ++b)
+    for (long i = 0; i < m.size(); ++i) forces.segment<3>(b * per_block + 3 * i) = m[i] * a;
+  return c.remap_from(forces, problem.time(), c.first_frame());
+}
+
+UniformPush fit_uniform_push(Problem& problem, const Scene& scene, const FewFitOptions& options) {
+  if (!problem.controls().forces()) throw std::logic_error("fit_uniform_push: the problem's controls are not forces");
+  problem.system().release_step_schedule();
+  UniformPush push;
+  FewVariableFit fitter(problem, scene, 3, [&problem](const VecX& y, VecX& z) {
+    z = uniform_push_controls(problem, Vec3(y));
+  }, options);
+  if (fitter.empty()) return push;
+  VecX y = VecX::Zero(3);
+  double cost = INFINITY, worst = INFINITY, start_cost = INFINITY;
+  push.stop = fitter.fit(y, cost, worst, start_cost);
+  push.simulated = fitter.simulated();
+  push.start_cost = start_cost;
+  if (!std::isfinite(cost)) return push;
+  push.a = Vec3(y);
+  push.z = uniform_push_controls(problem, push.a);
+  push.cost = cost;
+  push.worst_miss = worst / fitter.tolerance();
+  return push;
+}
+
+std::string describe(const UniformPush& push) {
+  std::ostringstream os;
+  os << std::setprecision(3) << "uniform push: Levenberg-Marquardt " << fit_stop_name(push.stop) << " after "
+     << push.simulated << " flights";
+  if (push.z.size())
+    os << ", a = (" << push.a.x() << ", " << push.a.y() << ", " << push.a.z() << ") m/s^2, keyframes' cost "
+       << push.start_cost << " -> " << push.cost << ", worst keyframe " << push.worst_miss << " tolerances";
+  return os.str();
+}
+
+}  // namespace kf
