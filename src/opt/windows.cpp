@@ -280,7 +280,7 @@ StagePlan plan_stages(const Scene& scene) {
   if (plan.growth > o.window_growth || contact) {
     plan.stages = window_stages(scene, o.max_evaluations, &plan.judged_until);
     plan.scaled_first_step = true;
-    plan.uniform_push = true;
+    plan.uniform_push = o.uniform_push;
     if (plan.growth > o.window_growth) os << " (above optimizer.window_growth " << o.window_growth << ")";
     else os << " (the sheet meets colliders or a body)";
     os << ": " << describe(plan.stages, plan.judged_until, last, c.from_frame);
@@ -289,7 +289,7 @@ StagePlan plan_stages(const Scene& scene) {
             "from frame " << c.from_frame;
     else if (keyframe_frames(scene).size() > 1)
       os << ", then the scene's forces from frame " << c.from_frame;
-    os << "; the first window starts from the uniform push that best places the keyframes";
+    if (plan.uniform_push) os << "; the first window starts from the uniform push that best places the keyframes";
   } else {
     os << " (not above optimizer.window_growth " << o.window_growth
        << "): one stage, then windows from no force if it ends early with evaluations left";

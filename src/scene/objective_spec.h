@@ -163,6 +163,10 @@ struct OptimizerSpec {
   // a run that ends early with a keyframe outside its tolerance raises that keyframe's weight and goes on
   // (opt/keyframe_weights.h).
   bool soft_keyframes = false;
+  // A uniform push (opt/uniform_push.h) fitted before the first window of a sheet's forces. Off by default: it
+  // costs up to 50 evaluations' worth of flights wherever it does not help (tests/results/reachable/README.md,
+  // "The uniform push").
+  bool uniform_push = false;
 };
 
 }  // namespace kf

@@ -334,6 +334,7 @@ OptimizerSpec parse_optimizer(Block b, const ControlSpec& scene_controls, int fr
   if (b.has("first_step")) o.first_step = b.number("first_step", 0.0, 0.0, 1e12);
   o.stop_when_reached = b.boolean("stop_when_reached", o.stop_when_reached);
   o.soft_keyframes = b.boolean("soft_keyframes", o.soft_keyframes);
+  o.uniform_push = b.boolean("uniform_push", o.uniform_push);
   b.finish();
   return o;
 }
