@@ -15,6 +15,11 @@ namespace {
 
 // A budget this small says nothing about whether more evaluations would reach the keyframes.
 constexpr int kFewEvaluations = 50;
+// The effort's share of the objective below which neither a keyframe's weight nor controls.alpha decides where
+// the run ends.
+constexpr double kNegligibleEffort = 0.01;
+// More evaluations than this many times those run, at the run's own rate: a budget the user will not give.
+constexpr double kHopelessBudgetRatio = 10;
 
 std::string format(const char* fmt, double a, double b = 0) {
   char buf[1024];
@@ -204,14 +209,21 @@ std::string smooth_cause(const Sensitivity& s, const RunFacts& facts) {
                   "costs less than the force that would remove it; change: raise the keyframe's weight or lower "
                   "controls.alpha",
                   100 * effort_share);
-  if (facts.budget)  // stalled before its budget ended: nothing measured says the target is out of reach
-    return format("cause: the dynamics are smooth (the gradient grows %.2gx over the horizon) and the objective "
-                  "stopped falling (%.2gx over the last tenth of the evaluations) before its budget ended (",
-                  s.growth, 1 / std::max(facts.recent_improvement, 1e-300)) +
-           facts.status +
-           format("), with the effort %.0f %% of the objective; change: raise the keyframe's weight, give the "
-                  "controls more time (controls.from_frame) or lower controls.alpha",
-                  100 * effort_share);
+  if (facts.budget) {  // stalled before its budget ended: nothing measured says the target is out of reach
+    const std::string head =
+        format("cause: the dynamics are smooth (the gradient grows %.2gx over the horizon) and the objective had "
+               "stopped falling (%.2gx over the last tenth of the evaluations) when its budget ended (",
+               s.growth, 1 / std::max(facts.recent_improvement, 1e-300)) +
+        facts.status + format("), with the effort %.0f %% of the objective", 100 * effort_share);
+    // Effort this small holds nothing back: a heavier keyframe or a lower alpha moves the same minimum.
+    if (effort_share < kNegligibleEffort)
+      return head + ", so neither the keyframe's weight nor controls.alpha holds it back: the run is in a basin "
+                    "whose lowest point misses the keyframe (a landing or a contact its gradient does not see "
+                    "past); change: keyframe before the contact, controls that act longer (controls.from_frame, "
+                    "or forces rather than an initial velocity), or move the keyframe";
+    return head + "; change: raise the keyframe's weight, give the controls more time (controls.from_frame) or "
+                  "lower controls.alpha";
+  }
   return format("cause: the dynamics are smooth (the gradient grows %.2gx over the horizon) and the "
                 "optimiser stopped (",
                 s.growth) +
@@ -294,7 +306,8 @@ std::string budget_expectation(const RunFacts& facts, double worst_miss) {
   if (more > 0)
     return "; at the rate the objective fell over " + over +
            format(" (%.2gx), the worst keyframe needs about %.0f more evaluations to come within its tolerance",
-                  1 / std::max(facts.recent_improvement, 1e-300), double(more));
+                  1 / std::max(facts.recent_improvement, 1e-300), double(more)) +
+           (more > kHopelessBudgetRatio * facts.evaluations ? " (more evaluations are not the remedy)" : "");
   if (facts.evaluations < kFewEvaluations)
     return "; the objective did not fall over " + over + ", too few evaluations to tell how many more it needs";
   return {};

@@ -86,6 +86,22 @@ TEST(DiagnosisTruth, AStallBeforeTheBudgetEndedIsNotCalledOutOfReach) {
   EXPECT_NE(diagnose(k, Sensitivity{}, run(10, 0.5, "converged")).line.find("out of reach"), std::string::npos);
 }
 
+// A run whose effort is a negligible share of its objective is not told to reweigh it: a heavier keyframe or a
+// lower alpha moves the same minimum. A rate that needs ten times the run's evaluations says so.
+TEST(DiagnosisTruth, AStallWithNoEffortIsNotSentToTheWeights) {
+  const std::vector<KeyframeJudgement> k = {judged("position@40", 40, 41.5, 19.6, "41.53 cm", "19.58 cm")};
+  RunFacts f = run(5.5, 1.23, "evaluation limit reached");
+  f.recent_improvement = 0.999;
+  f.effort_end = 0;
+  std::string line = diagnose(k, Sensitivity{}, f).line;
+  EXPECT_EQ(line.find("raise the keyframe's weight"), std::string::npos) << line;
+  EXPECT_NE(line.find("neither the keyframe's weight nor controls.alpha"), std::string::npos) << line;
+  EXPECT_NE(line.find("more evaluations are not the remedy"), std::string::npos) << line;
+  f.effort_end = 0.5;  // 29 % of the objective: the weights may decide it
+  line = diagnose(k, Sensitivity{}, f).line;
+  EXPECT_NE(line.find("raise the keyframe's weight"), std::string::npos) << line;
+}
+
 // The reduced generated drop onto a collider (two keyframes), cut to two evaluations a stage so that it fails
 // (at its default budget it reaches): its diagnosis blames the budget and names no cause it did not measure.
 // (Naming a keyframe left at its uncontrolled error is checked on judged keyframes above.)
