@@ -169,13 +169,15 @@ ThrowSearch search_and_fit_throws(Problem& problem, const Scene& scene, int coun
   std::vector<VecX> starts = {VecX::Zero(6)};
   if (fitted.z && *fitted.z != starts[0]) starts.push_back(*fitted.z);
   RigidThrowFit rigid = fit_rigid_throw(problem, scene, starts, o);
-  // A throw the fit brought to the keyframes needs no search (the scene's throw is still flown, once).
+  // A throw the fit brought within half of every tolerance (the search's own early end) needs no search, and no
+  // other start: the rigid stage judges it met (the scene's throw is still flown, once).
+  constexpr double kMet = 0.5;
+  const bool met = rigid.reached() || (rigid.z.size() == 6 && rigid.worst_miss <= kMet);
   const int spent = fitted.simulated + rigid.simulated;
-  const int searched = rigid.reached() ? 0 : std::max(0, std::min(count - rigid.simulated, budget - spent));
+  const int searched = met ? 0 : std::max(0, std::min(count - rigid.simulated, budget - spent));
   ThrowSearch s = search_throws(problem, searched, fitted, stop, &scene);
   s.simulated += rigid.simulated;
-  constexpr double kMet = 0.5;  // a fit within half of every tolerance, as the search's early end: no other start
-  if (!rigid.reached() && !s.met && !(rigid.z.size() == 6 && rigid.worst_miss <= kMet)) {
+  if (!met && !s.met) {
     const auto fitted_from = [&](const VecX& z) {
       return std::any_of(starts.begin(), starts.end(), [&](const VecX& a) { return a == z; });
     };

@@ -51,7 +51,8 @@ ThrowSearch search_throws(Problem& problem, int count, const FittedThrow& fitted
                           const std::atomic<bool>* stop = nullptr, const Scene* scene = nullptr);
 
 // What runs before a rigid first stage: Levenberg–Marquardt on the six rigid variables (opt/rigid_throw_fit.h)
-// from the scene's throw and the throw fitted to the keyframes; when that does not meet them, the search
+// from the scene's throw and the throw fitted to the keyframes; when that does not bring every keyframe within
+// half its tolerance (the search's own early end: the rigid stage judges the rest), the search
 // (`count` throws less the fit's flights) and the fit again from each of its kFitStarts best throws, until
 // one is within half of every tolerance (on a flight of more than kLargeFlight particle-steps from its best
 // alone, as its time allows). A flight that lands on a collider or the ground is a rough function of the
