@@ -31,6 +31,7 @@ UniformPush fit_uniform_push(Problem& problem, const Scene& scene, const FewFitO
   double cost = INFINITY, worst = INFINITY, start_cost = INFINITY;
   push.stop = fitter.fit(y, cost, worst, start_cost);
   push.simulated = fitter.simulated();
+  push.costs = fitter.costs();
   push.start_cost = start_cost;
   if (!std::isfinite(cost)) return push;
   push.a = Vec3(y);
@@ -47,6 +48,11 @@ std::string describe(const UniformPush& push) {
   if (push.z.size())
     os << ", a = (" << push.a.x() << ", " << push.a.y() << ", " << push.a.z() << ") m/s^2, keyframes' cost "
        << push.start_cost << " -> " << push.cost << ", worst keyframe " << push.worst_miss << " tolerances";
+  if (push.costs.size() > 1) {
+    os << " (cost after each step:";
+    for (size_t k = 1; k < push.costs.size(); ++k) os << ' ' << push.costs[k] / push.costs[0];
+    os << " of the start's)";
+  }
   return os.str();
 }
 

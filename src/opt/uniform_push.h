@@ -5,6 +5,7 @@
 // strategy starts the first stage of a sheet's forces from it (opt/strategy.cpp), where L-BFGS on the lattice
 // or on every particle stalls far from a solution of this kind (a sheet grazing a body's contact layer).
 #include <string>
+#include <vector>
 
 #include "core/types.h"
 #include "opt/few_variable_fit.h"
@@ -24,6 +25,7 @@ struct UniformPush {
   double cost = 0;        // and with the push a
   double worst_miss = 0;  // the largest keyframe distance under the push, in tolerances
   int simulated = 0;      // flights, Jacobians' included
+  std::vector<double> costs;  // the fit's cost at the start and after each accepted step
   FitStop stop = FitStop::kNoResiduals;
 };
 

@@ -88,6 +88,34 @@ TEST(UniformPush, ReducedGeneratedTiltsAreMetFromNoPush) {
   }
 }
 
+// The ½|g| ball and the paying test end a fit early. With the ball at a third of the push the keyframes ask
+// for, the fit is cut at its edge and stops when it heads out again, within two Jacobians and a few steps; with
+// a paying share no fit can meet, it stops after the steps it was given. Both leave the best point reached.
+TEST(UniformPush, TheBallAndThePayingTestEndAFitEarly) {
+  const ReachableScene r = generate_reachable("hang-corners", 52, 0, true, ".");
+  const Scene scene = parse_scene(r.scene.dump(), r.name + ".json");
+  auto sys = make_system(scene);
+  Problem problem(scene, scene.time, *sys);
+  FewFitOptions o;
+  o.max_step = 5;
+  o.max_norm = r.variant.dg.norm() / 3;
+  UniformPush push = fit_uniform_push(problem, scene, o);
+  EXPECT_EQ(push.stop, FitStop::kBounded) << describe(push);
+  EXPECT_LE(push.a.norm(), o.max_norm * (1 + 1e-9));
+  EXPECT_GT(push.a.norm(), 0.99 * o.max_norm) << "the cut step was taken";
+  EXPECT_LE(push.simulated, 25) << describe(push);
+  EXPECT_LT(push.cost, push.start_cost);
+  o.max_norm = 0;
+  o.paying_steps = 1;
+  o.paying_share = 1e-30;
+  push = fit_uniform_push(problem, scene, o);
+  EXPECT_EQ(push.stop, FitStop::kNotPaying) << describe(push);
+  ASSERT_EQ(push.costs.size(), 2u);
+  EXPECT_LT(push.costs[1], push.costs[0]);
+  EXPECT_EQ(push.cost, push.costs[1]);
+  EXPECT_LE(push.simulated, 14) << describe(push);  // a Jacobian, a step or a few, no second Jacobian
+}
+
 struct Lines final : StrategyLog {
   std::vector<std::string> lines;
   std::vector<int> budgets;
@@ -135,6 +163,45 @@ TEST(UniformPush, TheFirstStageStartsFromThePushAndPaysForItsFlights) {
                             [](const std::string& l) { return l.rfind("uniform push:", 0) == 0; }),
               1);
   }
+}
+
+// A push that is not kept leaves the run as without it: a sheet under a tenth of its gravity, whose keyframes
+// (fallen under all of it) ask for a push past half of its gravity, stops at the ball's edge; the stages'
+// budgets, evaluations and objectives are those of the run without the push, and its flights are reported.
+TEST(UniformPush, APushNotKeptLeavesTheRunAsWithoutIt) {
+  const ReachableScene r = generate_reachable("hang-corners", 52, 0, true, ".");
+  nlohmann::json j = r.scene;
+  const Vec3 g = parse_scene(r.scene.dump(), r.name + ".json").cloth->gravity;
+  j["cloth"]["gravity"] = {0.1 * g.x(), 0.1 * g.y(), 0.1 * g.z()};
+  const Scene scene = parse_scene(j.dump(), r.name + "-light.json");
+  ControlSpec window = scene.controls;
+  window.from_frame = scene.time.frames / 2;
+  StagePlan plan;
+  plan.stages = {{scene.time.substeps, 20, window}, {scene.time.substeps, 10, std::nullopt}};
+  std::vector<StrategyResult> runs;
+  std::vector<std::vector<int>> budgets;
+  for (const bool push : {false, true}) {
+    plan.uniform_push = push;
+    StrategyHooks hooks;
+    hooks.make_system = [&scene](double h) { return make_system(scene, h); };
+    StrategySetup setup{scene, plan};
+    setup.system = make_system(scene);
+    setup.start_time = scene.time;
+    Lines log;
+    runs.push_back(run_strategy(std::move(setup), hooks, log));
+    budgets.push_back(log.budgets);
+  }
+  ASSERT_TRUE(runs[1].uniform_push.has_value());
+  const UniformPush& p = *runs[1].uniform_push;
+  EXPECT_EQ(p.stop, FitStop::kBounded) << describe(p);
+  EXPECT_GT(p.simulated, 1);
+  EXPECT_EQ(budgets[1], budgets[0]);
+  ASSERT_EQ(runs[1].stages.size(), runs[0].stages.size());
+  for (size_t s = 0; s < runs[0].stages.size(); ++s) {
+    EXPECT_EQ(runs[1].stages[s].evaluations, runs[0].stages[s].evaluations) << "stage " << s;
+    EXPECT_EQ(runs[1].stages[s].objective_start, runs[0].stages[s].objective_start) << "stage " << s;
+  }
+  EXPECT_EQ(runs[1].evaluations, runs[0].evaluations);
 }
 
 // Not a check: the four gravity-tilt scenes the lattice stages stall on, along s·Δg and under the fit from no
