@@ -46,6 +46,7 @@ struct FewFitOptions {
   double max_norm = 0;
   // After this many accepted steps (0: never) the cost must be at most paying_share of the start's, or the fit
   // ends (kNotPaying): a fit that has not fallen by a clear factor in its first steps rarely does later.
+  // (fit_uniform_push also calls a fit that ends short of the keyframes above that share not paying.)
   int paying_steps = 0;
   double paying_share = 0.5;
 };

@@ -29,6 +29,10 @@ struct UniformPush {
   FitStop stop = FitStop::kNoResiduals;
 };
 
+// The strategy's fit (opt/strategy.cpp's push_uniformly_first): steps and differences in m/s², within half of
+// the scene's gravity, keyframes met at a quarter of their tolerance, the paying test on; at most `flights`.
+FewFitOptions uniform_push_options(const Scene& scene, int flights);
+
 // Levenberg–Marquardt on a from no push. `problem` must have force controls; its last rollout is left at an
 // arbitrary point and the system's step schedule released.
 UniformPush fit_uniform_push(Problem& problem, const Scene& scene, const FewFitOptions& options);

@@ -208,6 +208,25 @@ TEST(UniformPush, APushNotKeptLeavesTheRunAsWithoutIt) {
 // push. KEYFRAME_PUSH_SCENES="drop-collider-3 cape-wuson-0" picks the scenes (their files in the suite's
 // scenes folder, Δg from the generator). Run with KEYFRAME_NO_FP_TRAPS=1: the generator's own flight of a cape
 // on Testwuson.X divides by zero in the body query.
+// Not a check: the strategy's fit on scene files (KEYFRAME_PUSH_SCENES, paths), the paying test off
+// (KEYFRAME_PUSH_PAYING steps to turn it on), to read the cost after each step of the fits that paid and not.
+TEST(UniformPush, DISABLED_TraceStrategyFits) {
+  const char* env = std::getenv("KEYFRAME_PUSH_SCENES");
+  const char* paying = std::getenv("KEYFRAME_PUSH_PAYING");
+  std::istringstream list(env ? env : "");
+  for (std::string path; list >> path;) {
+    const Scene scene = load_scene(path);
+    auto sys = make_system(scene);
+    Problem problem(scene, scene.time, *sys);
+    if (!problem.controls().forces()) continue;
+    FewFitOptions o = uniform_push_options(scene, 100);
+    o.paying_steps = paying ? std::atoi(paying) : 0;
+    const double t0 = cpu_seconds();
+    const UniformPush push = fit_uniform_push(problem, scene, o);
+    std::cout << scene.name << ": " << describe(push) << "; " << cpu_seconds() - t0 << " CPU s" << std::endl;
+  }
+}
+
 TEST(UniformPush, DISABLED_DiagnoseGeneratedTilts) {
   const char* env = std::getenv("KEYFRAME_PUSH_SCENES");
   std::istringstream list(env ? env : "drop-collider-3 drop-collider-8 cape-wuson-0 cape-wuson-4");
