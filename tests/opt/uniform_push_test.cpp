@@ -124,26 +124,30 @@ struct Lines final : StrategyLog {
   void stage_started(int max_evaluations) override { budgets.push_back(max_evaluations); }
 };
 
+// A window from the scene's middle frame (`first` evaluations), then the whole horizon (10): run by the strategy.
+StrategyResult run_half_window_plan(const Scene& scene, int first, bool push, Lines& log) {
+  ControlSpec window = scene.controls;
+  window.from_frame = scene.time.frames / 2;
+  StagePlan plan;
+  plan.stages = {{scene.time.substeps, first, window}, {scene.time.substeps, 10, std::nullopt}};
+  plan.uniform_push = push;
+  StrategyHooks hooks;
+  hooks.make_system = [&scene](double h) { return make_system(scene, h); };
+  StrategySetup setup{scene, plan};
+  setup.system = make_system(scene);
+  setup.start_time = scene.time;
+  return run_strategy(std::move(setup), hooks, log);
+}
+
 // The strategy with a plan that asks for it: the first stage (here a window from a later frame) starts from the
 // push, the forces before its window held, and the push's flights come off the last stage's budget.
 TEST(UniformPush, TheFirstStageStartsFromThePushAndPaysForItsFlights) {
   const ReachableScene r = generate_reachable("hang-corners", 52, 0, true, ".");
   const Scene scene = parse_scene(r.scene.dump(), r.name + ".json");
-  ControlSpec window = scene.controls;
-  window.from_frame = scene.time.frames / 2;
-  StagePlan plan;
-  plan.stages = {{scene.time.substeps, 40, window}, {scene.time.substeps, 10, std::nullopt}};
-  plan.uniform_push = true;
   for (const bool push : {false, true}) {
     SCOPED_TRACE(push);
-    plan.uniform_push = push;
-    StrategyHooks hooks;
-    hooks.make_system = [&scene](double h) { return make_system(scene, h); };
-    StrategySetup setup{scene, plan};
-    setup.system = make_system(scene);
-    setup.start_time = scene.time;
     Lines log;
-    const StrategyResult res = run_strategy(std::move(setup), hooks, log);
+    const StrategyResult res = run_half_window_plan(scene, 40, push, log);
     ASSERT_FALSE(res.stages.empty());
     ASSERT_EQ(res.uniform_push.has_value(), push);
     if (!push) {
@@ -174,21 +178,11 @@ TEST(UniformPush, APushNotKeptLeavesTheRunAsWithoutIt) {
   const Vec3 g = parse_scene(r.scene.dump(), r.name + ".json").cloth->gravity;
   j["cloth"]["gravity"] = {0.1 * g.x(), 0.1 * g.y(), 0.1 * g.z()};
   const Scene scene = parse_scene(j.dump(), r.name + "-light.json");
-  ControlSpec window = scene.controls;
-  window.from_frame = scene.time.frames / 2;
-  StagePlan plan;
-  plan.stages = {{scene.time.substeps, 20, window}, {scene.time.substeps, 10, std::nullopt}};
   std::vector<StrategyResult> runs;
   std::vector<std::vector<int>> budgets;
   for (const bool push : {false, true}) {
-    plan.uniform_push = push;
-    StrategyHooks hooks;
-    hooks.make_system = [&scene](double h) { return make_system(scene, h); };
-    StrategySetup setup{scene, plan};
-    setup.system = make_system(scene);
-    setup.start_time = scene.time;
     Lines log;
-    runs.push_back(run_strategy(std::move(setup), hooks, log));
+    runs.push_back(run_half_window_plan(scene, 20, push, log));
     budgets.push_back(log.budgets);
   }
   ASSERT_TRUE(runs[1].uniform_push.has_value());
