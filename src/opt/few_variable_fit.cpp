@@ -61,13 +61,9 @@ FitStop FewVariableFit::fit(VecX& y, double& cost, double& worst, double& start_
       if (step.norm() > o_.max_step) step *= o_.max_step / step.norm();
       VecX trial_y = y;
       for (int d = 0; d < n_; ++d) trial_y[d] += step[d] / scale(d);
-      if (o_.max_norm > 0 && scaled_norm(trial_y) > o_.max_norm) {
-        // Bounded: from the edge (within a millionth of it) the fit heads out of the ball; from inside, the
-        // step is cut radially at its edge.
-        if (scaled_norm(y) >= (1 - 1e-6) * o_.max_norm) return FitStop::kBounded;
-        trial_y *= o_.max_norm / scaled_norm(trial_y);
-        for (int d = 0; d < n_; ++d) step[d] = (trial_y[d] - y[d]) * scale(d);
-      }
+      // A step out of the ball: the fit heads for a point the caller does not want (one found inside after
+      // such a step is another basin's, poncho-lift's lift).
+      if (o_.max_norm > 0 && scaled_norm(trial_y) > o_.max_norm) return FitStop::kBounded;
       const double predicted = -(step.dot(jtr) + 0.5 * step.dot(jtj * step));
       double trial_worst = 0;
       if (out_of_budget()) return stopped();

@@ -25,7 +25,7 @@ enum class FitStop {
   kInterrupted,  // *stop was set
   kNoResiduals,  // no keyframe places the sheet's particles (nothing to fit)
   kDiverged,     // the start itself diverged
-  kBounded,      // a step from the edge of FewFitOptions::max_norm's ball left it again: the fit heads past it
+  kBounded,      // a trial step would leave FewFitOptions::max_norm's ball: the fit heads past it
   kNotPaying,    // FewFitOptions::paying_steps steps in, the cost was not down to paying_share of the start's
 };
 
@@ -41,8 +41,8 @@ struct FewFitOptions {
   double max_step = 2.0;          // the longest damped step, scaled
   double difference_step = 1e-3;  // the central differences' step, scaled
   const std::atomic<bool>* stop = nullptr;  // set: the fit ends after the flight under way
-  // The scaled variables stay in the ball of this radius (0: no bound): a step that would leave it is cut at its
-  // edge, and one that would leave it again from the edge ends the fit (kBounded) without flying.
+  // The scaled variables stay in the ball of this radius (0: no bound): a trial step that would leave it ends
+  // the fit (kBounded) without flying, at the best point reached.
   double max_norm = 0;
   // After this many accepted steps (0: never) the cost must be at most paying_share of the start's, or the fit
   // ends (kNotPaying): a fit that has not fallen by a clear factor in its first steps rarely does later.

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <ctime>
 #include <iostream>
@@ -89,8 +90,8 @@ TEST(UniformPush, ReducedGeneratedTiltsAreMetFromNoPush) {
 }
 
 // The ½|g| ball and the paying test end a fit early. With the ball at a third of the push the keyframes ask
-// for, the fit is cut at its edge and stops when it heads out again, within two Jacobians and a few steps; with
-// a paying share no fit can meet, it stops after the steps it was given. Both leave the best point reached.
+// for, the fit's first step would leave it: it stops there, after its first Jacobian, at no push; with a paying
+// share no fit can meet, it stops after the steps it was given, at the best point reached.
 TEST(UniformPush, TheBallAndThePayingTestEndAFitEarly) {
   const ReachableScene r = generate_reachable("hang-corners", 52, 0, true, ".");
   const Scene scene = parse_scene(r.scene.dump(), r.name + ".json");
@@ -101,10 +102,11 @@ TEST(UniformPush, TheBallAndThePayingTestEndAFitEarly) {
   o.max_norm = r.variant.dg.norm() / 3;
   UniformPush push = fit_uniform_push(problem, scene, o);
   EXPECT_EQ(push.stop, FitStop::kBounded) << describe(push);
-  EXPECT_LE(push.a.norm(), o.max_norm * (1 + 1e-9));
-  EXPECT_GT(push.a.norm(), 0.99 * o.max_norm) << "the cut step was taken";
-  EXPECT_LE(push.simulated, 25) << describe(push);
-  EXPECT_LT(push.cost, push.start_cost);
+  EXPECT_EQ(push.a.norm(), 0.0);
+  EXPECT_EQ(push.simulated, 7) << describe(push);  // the start and one Jacobian's six
+  // A ball wide enough: the fit as without it.
+  o.max_norm = 10 * r.variant.dg.norm();
+  EXPECT_EQ(fit_uniform_push(problem, scene, o).stop, FitStop::kReached);
   o.max_norm = 0;
   o.paying_steps = 1;
   o.paying_share = 1e-30;
@@ -218,6 +220,69 @@ TEST(UniformPush, DISABLED_TraceStrategyFits) {
     const double t0 = cpu_seconds();
     const UniformPush push = fit_uniform_push(problem, scene, o);
     std::cout << scene.name << ": " << describe(push) << "; " << cpu_seconds() - t0 << " CPU s" << std::endl;
+  }
+}
+
+// Halton's radical inverse of k in base b (a point set that fills a box evenly).
+double radical_inverse(int k, int b) {
+  double r = 0, f = 1;
+  for (; k > 0; k /= b) {
+    f /= b;
+    r += f * (k % b);
+  }
+  return r;
+}
+
+// Not a check: a global search over pushes before the fit. KEYFRAME_PUSH_SAMPLES (64) Halton points in the ball
+// of half of gravity, flown forward; Levenberg–Marquardt (the strategy's options, paying test off) from the best
+// three. Prints where the best samples and fits lie against the generator's Δg (KEYFRAME_PUSH_SCENES: names).
+TEST(UniformPush, DISABLED_HaltonSearchBeforeTheFit) {
+  const char* env = std::getenv("KEYFRAME_PUSH_SCENES");
+  const char* samples_env = std::getenv("KEYFRAME_PUSH_SAMPLES");
+  const int samples = samples_env ? std::atoi(samples_env) : 64;
+  std::istringstream list(env ? env : "cape-wuson-0 cape-wuson-4 drop-collider-8");
+  const std::filesystem::path dir = std::filesystem::path(KEYFRAME_SOURCE_DIR) / "tests/results/reachable/scenes";
+  for (std::string name; list >> name;) {
+    const size_t dash = name.rfind('-');
+    const ReachableScene r = generate_reachable(name.substr(0, dash), 52, std::stoi(name.substr(dash + 1)), false, dir);
+    const Scene scene = load_scene(dir / (name + ".json"));
+    auto sys = make_system(scene);
+    Problem problem(scene, scene.time, *sys);
+    const std::vector<PlacedKeyframe> placed = placed_keyframes(problem, scene);
+    VecX res(residual_count(placed));
+    const FewFitOptions o0 = uniform_push_options(scene, 100);
+    const double radius = o0.max_norm, t0 = cpu_seconds();
+    std::vector<std::pair<double, Vec3>> flown;
+    for (int k = 1; int(flown.size()) < samples; ++k) {
+      const Vec3 a = radius * Vec3(2 * radical_inverse(k, 2) - 1, 2 * radical_inverse(k, 3) - 1, 2 * radical_inverse(k, 5) - 1);
+      if (a.norm() > radius) continue;
+      problem.evaluate(uniform_push_controls(problem, a), nullptr);
+      const double worst = problem.last_diverged() ? INFINITY : keyframe_residuals(problem.rollout(), placed, true, res);
+      flown.push_back({std::isfinite(worst) ? 0.5 * res.squaredNorm() : INFINITY, a});
+    }
+    std::sort(flown.begin(), flown.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    problem.evaluate(uniform_push_controls(problem, Vec3::Zero()), nullptr);
+    keyframe_residuals(problem.rollout(), placed, true, res);
+    const double none = 0.5 * res.squaredNorm();
+    const Vec3 dg = r.variant.dg;
+    std::cout << name << ": |dg| " << dg.norm() << ", " << samples << " samples in " << cpu_seconds() - t0
+              << " CPU s; cost with none " << none << "\n";
+    for (int b = 0; b < 3; ++b) {
+      std::cout << "  sample " << b << ": cost " << flown[b].first / none << " of none's, |a-dg|/|dg| "
+                << (flown[b].second - dg).norm() / dg.norm() << "\n";
+      FewFitOptions o = o0;
+      o.paying_steps = 0;
+      FewVariableFit fitter(problem, scene, 3, [&problem](const VecX& y, VecX& z) {
+        z = uniform_push_controls(problem, Vec3(y));
+      }, o);
+      VecX y = flown[b].second;
+      double cost, worst, start;
+      const double t1 = cpu_seconds();
+      const FitStop stop = fitter.fit(y, cost, worst, start);
+      std::cout << "    LM " << fit_stop_name(stop) << " after " << fitter.simulated() << " flights (" << cpu_seconds() - t1
+                << " CPU s): cost " << cost / none << " of none's, worst keyframe " << worst / fitter.tolerance()
+                << " tolerances, |a-dg|/|dg| " << (Vec3(y) - dg).norm() / dg.norm() << std::endl;
+    }
   }
 }
 
