@@ -486,7 +486,7 @@ void push_uniformly_first(Run& run, std::vector<StageSpec>& stages) {
   os << describe(push) << " in " << std::fixed << std::setprecision(2) << seconds << " s (charged " << worth
      << " evaluations); " << std::scientific << std::setprecision(3) << "keyframe terms " << before << " with none, "
      << after << " with it: " << (keep ? "the first stage starts from it" : "not kept");
-  if (!keep && after < before && !paid) os << " (" << fit_stop_name(push.stop) << ")";
+  if (!paid) os << " (" << fit_stop_name(push.stop) << ")";
   run.log.say(os.str());
   r.uniform_push = push;
   if (!keep) return;

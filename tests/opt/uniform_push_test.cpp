@@ -223,6 +223,15 @@ TEST(UniformPush, DISABLED_TraceStrategyFits) {
   }
 }
 
+const std::filesystem::path kSuiteScenes = std::filesystem::path(KEYFRAME_SOURCE_DIR) / "tests/results/reachable/scenes";
+
+// A suite scene by its name ("cape-wuson-0"): the generator's variant (Δg and the rest) and the scene file.
+std::pair<ReachableScene, Scene> suite_scene(const std::string& name) {
+  const size_t dash = name.rfind('-');
+  return {generate_reachable(name.substr(0, dash), 52, std::stoi(name.substr(dash + 1)), false, kSuiteScenes),
+          load_scene(kSuiteScenes / (name + ".json"))};
+}
+
 // Halton's radical inverse of k in base b (a point set that fills a box evenly).
 double radical_inverse(int k, int b) {
   double r = 0, f = 1;
@@ -241,11 +250,8 @@ TEST(UniformPush, DISABLED_HaltonSearchBeforeTheFit) {
   const char* samples_env = std::getenv("KEYFRAME_PUSH_SAMPLES");
   const int samples = samples_env ? std::atoi(samples_env) : 64;
   std::istringstream list(env ? env : "cape-wuson-0 cape-wuson-4 drop-collider-8");
-  const std::filesystem::path dir = std::filesystem::path(KEYFRAME_SOURCE_DIR) / "tests/results/reachable/scenes";
   for (std::string name; list >> name;) {
-    const size_t dash = name.rfind('-');
-    const ReachableScene r = generate_reachable(name.substr(0, dash), 52, std::stoi(name.substr(dash + 1)), false, dir);
-    const Scene scene = load_scene(dir / (name + ".json"));
+    const auto [r, scene] = suite_scene(name);
     auto sys = make_system(scene);
     Problem problem(scene, scene.time, *sys);
     const std::vector<PlacedKeyframe> placed = placed_keyframes(problem, scene);
@@ -289,11 +295,8 @@ TEST(UniformPush, DISABLED_HaltonSearchBeforeTheFit) {
 TEST(UniformPush, DISABLED_DiagnoseGeneratedTilts) {
   const char* env = std::getenv("KEYFRAME_PUSH_SCENES");
   std::istringstream list(env ? env : "drop-collider-3 drop-collider-8 cape-wuson-0 cape-wuson-4");
-  const std::filesystem::path dir = std::filesystem::path(KEYFRAME_SOURCE_DIR) / "tests/results/reachable/scenes";
   for (std::string name; list >> name;) {
-    const size_t dash = name.rfind('-');
-    const ReachableScene r = generate_reachable(name.substr(0, dash), 52, std::stoi(name.substr(dash + 1)), false, dir);
-    const Scene scene = load_scene(dir / (name + ".json"));
+    const auto [r, scene] = suite_scene(name);
     auto sys = make_system(scene);
     Problem problem(scene, scene.time, *sys);
     const Vec3 dg = r.variant.dg;
