@@ -125,6 +125,8 @@ nlohmann::json report_summary(const Scene& scene, bool resuming, const OptimizeR
           {"status", job.status},
           {"interrupted", job.interrupted},
           {"evaluations", job.evaluations},
+          // the uniform push's flights (opt/uniform_push.h), kept or not: half an evaluation each, not in the above
+          {"push_flights", job.uniform_push ? job.uniform_push->simulated : 0},
           {"capped_trials", job.capped_trials},
           {"wall_seconds", job.seconds},
           {"initial_objective", history.empty() ? 0.0 : history.front().rec.phi},

@@ -18,6 +18,8 @@ const char* fit_stop_name(FitStop s) {
     case FitStop::kInterrupted: return "interrupted";
     case FitStop::kNoResiduals: return "nothing placed";
     case FitStop::kDiverged: return "start diverged";
+    case FitStop::kBounded: return "bounded";
+    case FitStop::kNotPaying: return "not paying";
   }
   return "?";
 }
@@ -41,9 +43,12 @@ FewVariableFit::FewVariableFit(Problem& problem, const Scene& scene, int variabl
 FitStop FewVariableFit::fit(VecX& y, double& cost, double& worst, double& start_cost) {
   if (!fly(y, r_, worst)) return FitStop::kDiverged;
   cost = start_cost = 0.5 * r_.squaredNorm();
+  costs_.assign(1, cost);
   double lambda = -1, nu = 2;
   for (;;) {
     if (worst <= reach_) return FitStop::kReached;
+    if (o_.paying_steps > 0 && int(costs_.size()) > o_.paying_steps && cost > o_.paying_share * start_cost)
+      return FitStop::kNotPaying;
     if (!jacobian(y)) return stopped();
     const Eigen::MatrixXd jtj = jacobian_.transpose() * jacobian_;
     const VecX jtr = jacobian_.transpose() * r_;
@@ -54,9 +59,12 @@ FitStop FewVariableFit::fit(VecX& y, double& cost, double& worst, double& start_
       VecX step = -a.ldlt().solve(jtr);
       if (!step.allFinite()) return FitStop::kStalled;
       if (step.norm() > o_.max_step) step *= o_.max_step / step.norm();
-      const double predicted = -(step.dot(jtr) + 0.5 * step.dot(jtj * step));
       VecX trial_y = y;
       for (int d = 0; d < n_; ++d) trial_y[d] += step[d] / scale(d);
+      // A step out of the ball: the fit heads for a point the caller does not want (one found inside after
+      // such a step is another basin's, poncho-lift's lift).
+      if (o_.max_norm > 0 && scaled_norm(trial_y) > o_.max_norm) return FitStop::kBounded;
+      const double predicted = -(step.dot(jtr) + 0.5 * step.dot(jtj * step));
       double trial_worst = 0;
       if (out_of_budget()) return stopped();
       const bool flew = fly(trial_y, trial_, trial_worst);
@@ -70,6 +78,7 @@ FitStop FewVariableFit::fit(VecX& y, double& cost, double& worst, double& start_
         cost = trial_cost;
         worst = trial_worst;
         r_.swap(trial_);
+        costs_.push_back(cost);
         if (negligible) return worst <= reach_ ? FitStop::kReached : FitStop::kConverged;
         break;
       }
@@ -78,6 +87,12 @@ FitStop FewVariableFit::fit(VecX& y, double& cost, double& worst, double& start_
       if (step.norm() < 1e-12 || lambda > 1e12 * std::max(1e-300, jtj.diagonal().maxCoeff())) return FitStop::kStalled;
     }
   }
+}
+
+double FewVariableFit::scaled_norm(const VecX& y) const {
+  double sum = 0;
+  for (int d = 0; d < n_; ++d) sum += std::pow(y[d] * scale(d), 2);
+  return std::sqrt(sum);
 }
 
 bool FewVariableFit::fly(const VecX& y, VecX& r, double& worst) {

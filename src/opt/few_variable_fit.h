@@ -25,6 +25,8 @@ enum class FitStop {
   kInterrupted,  // *stop was set
   kNoResiduals,  // no keyframe places the sheet's particles (nothing to fit)
   kDiverged,     // the start itself diverged
+  kBounded,      // a trial step would leave FewFitOptions::max_norm's ball: the fit heads past it
+  kNotPaying,    // FewFitOptions::paying_steps steps in, the cost was not down to paying_share of the start's
 };
 
 const char* fit_stop_name(FitStop s);
@@ -39,6 +41,14 @@ struct FewFitOptions {
   double max_step = 2.0;          // the longest damped step, scaled
   double difference_step = 1e-3;  // the central differences' step, scaled
   const std::atomic<bool>* stop = nullptr;  // set: the fit ends after the flight under way
+  // The scaled variables stay in the ball of this radius (0: no bound): a trial step that would leave it ends
+  // the fit (kBounded) without flying, at the best point reached.
+  double max_norm = 0;
+  // After this many accepted steps (0: never) the cost must be at most paying_share of the start's, or the fit
+  // ends (kNotPaying): a fit that has not fallen by a clear factor in its first steps rarely does later.
+  // (fit_uniform_push also calls a fit that ends short of the keyframes above that share not paying.)
+  int paying_steps = 0;
+  double paying_share = 0.5;
 };
 
 // y (n) -> the problem's controls z (resized by the callee).
@@ -51,6 +61,8 @@ class FewVariableFit {
   bool empty() const { return placed_.empty(); }
   int simulated() const { return simulated_; }
   double tolerance() const { return tolerance_; }
+  // ½‖r‖² at the start and after each accepted step (the log's trace of a fit).
+  const std::vector<double>& costs() const { return costs_; }
   bool out_of_budget() const { return simulated_ >= budget_ || (stop_ && stop_->load()); }
 
   // Levenberg–Marquardt from y (in and out: the best point reached), its cost ½‖r‖² (weighted as φ weighs the
@@ -62,6 +74,7 @@ class FewVariableFit {
   bool fly(const VecX& y, VecX& r, double& worst);
   bool jacobian(const VecX& y);
   double scale(int d) const { return o_.scales.size() ? o_.scales[d] : 1.0; }
+  double scaled_norm(const VecX& y) const;
 
   Problem& problem_;
   std::vector<PlacedKeyframe> placed_;
@@ -73,6 +86,7 @@ class FewVariableFit {
   double tolerance_ = 0.01, reach_ = 0;
   int simulated_ = 0;
   VecX r_, trial_, z_;
+  std::vector<double> costs_;
   Eigen::MatrixXd jacobian_;
 };
 

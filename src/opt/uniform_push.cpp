@@ -19,6 +19,18 @@ VecX uniform_push_controls(Problem& problem, const Vec3& a) {
   return c.remap_from(forces, problem.time(), c.first_frame());
 }
 
+FewFitOptions uniform_push_options(const Scene& scene, int flights) {
+  FewFitOptions o;
+  o.max_simulations = flights;
+  o.max_step = 5;            // m/s²: a tilt of gravity by half of it
+  o.difference_step = 0.1;   // m/s²: a slope over the contact's kinks, which a millimetre's difference sees
+  o.reach_share = 0.25;      // keyframes met with a margin: the stage judges them, not more flights
+  o.max_norm = scene.cloth ? 0.5 * scene.cloth->gravity.norm() : 0;  // a push past it is no tilt of gravity
+  o.paying_steps = 4;
+  o.paying_share = 0.5;
+  return o;
+}
+
 UniformPush fit_uniform_push(Problem& problem, const Scene& scene, const FewFitOptions& options) {
   if (!problem.controls().forces()) throw std::logic_error("fit_uniform_push: the problem's controls are not forces");
   problem.system().release_step_schedule();
@@ -31,6 +43,11 @@ UniformPush fit_uniform_push(Problem& problem, const Scene& scene, const FewFitO
   double cost = INFINITY, worst = INFINITY, start_cost = INFINITY;
   push.stop = fitter.fit(y, cost, worst, start_cost);
   push.simulated = fitter.simulated();
+  push.costs = fitter.costs();
+  // Ended short of the keyframes without halving their cost: a push that did not pay (the paying test at the
+  // fit's end as at its steps).
+  const bool ended = push.stop == FitStop::kConverged || push.stop == FitStop::kStalled || push.stop == FitStop::kBudget;
+  if (options.paying_steps > 0 && ended && cost > options.paying_share * start_cost) push.stop = FitStop::kNotPaying;
   push.start_cost = start_cost;
   if (!std::isfinite(cost)) return push;
   push.a = Vec3(y);
@@ -47,6 +64,11 @@ std::string describe(const UniformPush& push) {
   if (push.z.size())
     os << ", a = (" << push.a.x() << ", " << push.a.y() << ", " << push.a.z() << ") m/s^2, keyframes' cost "
        << push.start_cost << " -> " << push.cost << ", worst keyframe " << push.worst_miss << " tolerances";
+  if (push.costs.size() > 1) {
+    os << " (cost after each step:";
+    for (size_t k = 1; k < push.costs.size(); ++k) os << ' ' << push.costs[k] / push.costs[0];
+    os << " of the start's)";
+  }
   return os.str();
 }
 

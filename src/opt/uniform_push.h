@@ -5,6 +5,7 @@
 // strategy starts the first stage of a sheet's forces from it (opt/strategy.cpp), where L-BFGS on the lattice
 // or on every particle stalls far from a solution of this kind (a sheet grazing a body's contact layer).
 #include <string>
+#include <vector>
 
 #include "core/types.h"
 #include "opt/few_variable_fit.h"
@@ -24,8 +25,13 @@ struct UniformPush {
   double cost = 0;        // and with the push a
   double worst_miss = 0;  // the largest keyframe distance under the push, in tolerances
   int simulated = 0;      // flights, Jacobians' included
+  std::vector<double> costs;  // the fit's cost at the start and after each accepted step
   FitStop stop = FitStop::kNoResiduals;
 };
+
+// The strategy's fit (opt/strategy.cpp's push_uniformly_first): steps and differences in m/s², within half of
+// the scene's gravity, keyframes met at a quarter of their tolerance, the paying test on; at most `flights`.
+FewFitOptions uniform_push_options(const Scene& scene, int flights);
 
 // Levenberg–Marquardt on a from no push. `problem` must have force controls; its last rollout is left at an
 // arbitrary point and the system's step schedule released.

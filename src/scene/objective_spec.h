@@ -163,10 +163,10 @@ struct OptimizerSpec {
   // a run that ends early with a keyframe outside its tolerance raises that keyframe's weight and goes on
   // (opt/keyframe_weights.h).
   bool soft_keyframes = false;
-  // A uniform push (opt/uniform_push.h) fitted before the first window of a sheet's forces. Off by default: it
-  // costs up to 50 evaluations' worth of flights wherever it does not help (tests/results/reachable/README.md,
-  // "The uniform push").
-  bool uniform_push = false;
+  // A uniform push (opt/uniform_push.h) fitted before the first window of a sheet's forces, within half of
+  // gravity; the first window starts from it when it pays (tests/results/reachable/README.md, "The uniform push
+  // as a default").
+  bool uniform_push = true;
 };
 
 }  // namespace kf
