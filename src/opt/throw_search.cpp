@@ -11,9 +11,6 @@
 
 namespace kf {
 
-namespace {
-
-// The k-th element (k >= 1) of the van der Corput sequence in base b: the digits of k mirrored about the point.
 double radical_inverse(int k, int b) {
   double f = 1, r = 0;
   for (; k > 0; k /= b) {
@@ -22,8 +19,6 @@ double radical_inverse(int k, int b) {
   }
   return r;
 }
-
-}  // namespace
 
 double large_flight_share(int particles, int steps) {
   const double per_flight = std::max(1.0, double(particles) * std::max(1, steps));

@@ -27,6 +27,10 @@ struct ThrowSearch {
   std::vector<VecX> best_throws;       // the search's own best few throws (kFitStarts at most), lowest φ first
 };
 
+// The k-th element (k >= 1) of the van der Corput sequence in base b: the digits of k mirrored about the point.
+// Bases 2, 3, 5, ... side by side give Halton's points, which fill a box evenly (the search's throws).
+double radical_inverse(int k, int b);
+
 // The fit after the search starts from this many of its best throws (one on a flight beyond kLargeFlight).
 constexpr int kFitStarts = 4;
 

@@ -55,8 +55,9 @@ struct StagePlan {
   // whole horizon may settle on forces far costlier than windows find (a flag released in its plane).
   bool windows_on_early_end = false;
   // optimizer.uniform_push, on windows of forces on a sheet (per step or per frame): the first window starts
-  // from the uniform push that best places the keyframes (opt/uniform_push.h), when it lowers their terms. Not
-  // in one tame stage: started from a push, its L-BFGS lost hang-edge-6 and hang-points-6.
+  // from the uniform push that best places the keyframes (opt/uniform_push.h), when the fit paid and stayed
+  // within half of gravity (push_uniformly_first in opt/strategy.cpp). Not in one tame stage: started from a
+  // push, its L-BFGS lost hang-edge-6 and hang-points-6.
   bool uniform_push = false;
   std::string why;                // one line: the plan and what chose it
   // A large flight's stages share fewer evaluations than optimizer.max_evaluations: how many (0: not scaled).

@@ -14,6 +14,7 @@
 #include "opt/keyframes/keyframe_common.h"
 #include "opt/problem.h"
 #include "opt/strategy.h"
+#include "opt/throw_search.h"
 #include "opt/uniform_push.h"
 #include "scene/scene.h"
 #include "sim/make_system.h"
@@ -230,16 +231,6 @@ std::pair<ReachableScene, Scene> suite_scene(const std::string& name) {
   const size_t dash = name.rfind('-');
   return {generate_reachable(name.substr(0, dash), 52, std::stoi(name.substr(dash + 1)), false, kSuiteScenes),
           load_scene(kSuiteScenes / (name + ".json"))};
-}
-
-// Halton's radical inverse of k in base b (a point set that fills a box evenly).
-double radical_inverse(int k, int b) {
-  double r = 0, f = 1;
-  for (; k > 0; k /= b) {
-    f /= b;
-    r += f * (k % b);
-  }
-  return r;
 }
 
 // Not a check: a global search over pushes before the fit. KEYFRAME_PUSH_SAMPLES (64) Halton points in the ball
