@@ -41,6 +41,13 @@ FewVariableFit::FewVariableFit(Problem& problem, const Scene& scene, int variabl
 }
 
 FitStop FewVariableFit::fit(VecX& y, double& cost, double& worst, double& start_cost) {
+  const FitStop stop = steps(y, cost, worst, start_cost);
+  // Ended short of the keyframes without the paying share: the paying test at the fit's end as at its steps.
+  const bool ended = stop == FitStop::kConverged || stop == FitStop::kStalled || stop == FitStop::kBudget;
+  return o_.paying_steps > 0 && ended && cost > o_.paying_share * start_cost ? FitStop::kNotPaying : stop;
+}
+
+FitStop FewVariableFit::steps(VecX& y, double& cost, double& worst, double& start_cost) {
   if (!fly(y, r_, worst)) return FitStop::kDiverged;
   cost = start_cost = 0.5 * r_.squaredNorm();
   costs_.assign(1, cost);

@@ -46,7 +46,8 @@ struct FewFitOptions {
   double max_norm = 0;
   // After this many accepted steps (0: never) the cost must be at most paying_share of the start's, or the fit
   // ends (kNotPaying): a fit that has not fallen by a clear factor in its first steps rarely does later.
-  // (fit_uniform_push also calls a fit that ends short of the keyframes above that share not paying.)
+  // A fit that ends short of the keyframes (converged, stalled, out of flights) above that share is not paying
+  // either.
   int paying_steps = 0;
   double paying_share = 0.5;
 };
@@ -70,6 +71,7 @@ class FewVariableFit {
   FitStop fit(VecX& y, double& cost, double& worst, double& start_cost);
 
  private:
+  FitStop steps(VecX& y, double& cost, double& worst, double& start_cost);  // fit() before its end's paying test
   FitStop stopped() const { return stop_ && stop_->load() ? FitStop::kInterrupted : FitStop::kBudget; }
   bool fly(const VecX& y, VecX& r, double& worst);
   bool jacobian(const VecX& y);

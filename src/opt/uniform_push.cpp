@@ -44,10 +44,6 @@ UniformPush fit_uniform_push(Problem& problem, const Scene& scene, const FewFitO
   push.stop = fitter.fit(y, cost, worst, start_cost);
   push.simulated = fitter.simulated();
   push.costs = fitter.costs();
-  // Ended short of the keyframes without halving their cost: a push that did not pay (the paying test at the
-  // fit's end as at its steps).
-  const bool ended = push.stop == FitStop::kConverged || push.stop == FitStop::kStalled || push.stop == FitStop::kBudget;
-  if (options.paying_steps > 0 && ended && cost > options.paying_share * start_cost) push.stop = FitStop::kNotPaying;
   push.start_cost = start_cost;
   if (!std::isfinite(cost)) return push;
   push.a = Vec3(y);
