@@ -4,11 +4,17 @@
 
 #include <filesystem>
 #include <fstream>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
 #include <set>
+#include <sstream>
 
 #include "../support/reachable_classes.h"
 #include "bench/bench_reachable.h"
 #include "adjoint/rollout.h"
+#include "opt/keyframe_residuals.h"
+#include "opt/keyframes/keyframe_common.h"
 #include "opt/problem.h"
 #include "scene/scene.h"
 #include "sim/make_system.h"
@@ -132,6 +138,64 @@ TEST(ReachableScenes, CommittedSuiteCoversItsShares) {
     const ReachableScene r = generate_reachable(kind, ReachableSweepOptions{}.seed,
                                                 std::stoi(name.substr(name.rfind('-') + 1)), false, kDir);
     EXPECT_EQ(r.scene, nlohmann::json::parse(in)) << name;
+  }
+}
+
+// Not a check: how well conditioned each generated cloth scene's keyframes are. The variant's change (dg, or dv
+// and omega) is moved by a fraction eps of its own size (scaled by 1 +- eps, and turned eps off its direction two
+// ways), and the keyframed particles' RMS displacement from the variant's own motion is measured in each
+// keyframe's tolerance; the row keeps the largest over the four. A keyframe that a thousandth of the change
+// moves by more than its tolerance is a knife edge: reachable, but from no neighbourhood a search can land in.
+//   KEYFRAME_NO_FP_TRAPS=1 KEYFRAME_CONDITIONING_CSV=OUT.csv keyframe_tests
+//     --gtest_also_run_disabled_tests --gtest_filter='ReachableScenes.DISABLED_Conditioning*'
+//   (KEYFRAME_CONDITIONING_SCENES="throw-2 ..." for some)
+Vec3 turned(const Vec3& c, double eps, int how) {
+  if (c.norm() == 0) return c;
+  if (how < 2) return c * (how == 0 ? 1 + eps : 1 - eps);
+  const Vec3 a = std::abs(c.x()) < 0.6 * c.norm() ? Vec3::UnitX() : Vec3::UnitY();
+  const Vec3 e1 = c.cross(a).normalized(), e2 = c.cross(e1).normalized();
+  return c + eps * c.norm() * (how == 2 ? e1 : e2);
+}
+
+TEST(ReachableScenes, DISABLED_ConditioningOfEveryClothScene) {
+  const char* only = std::getenv("KEYFRAME_CONDITIONING_SCENES");
+  const char* path = std::getenv("KEYFRAME_CONDITIONING_CSV");
+  std::set<std::string> chosen;
+  if (only) {
+    std::istringstream in(only);
+    for (std::string s; in >> s;) chosen.insert(s);
+  }
+  std::ofstream csv(path ? path : "conditioning.csv");
+  csv << "scene,class,keyframes,eps,worst_displacement_tol\n";
+  for (const auto& [name, kind] : reachable_suite(ReachableSweepOptions{})) {
+    if (kind.rfind("flock", 0) == 0 || (only && !chosen.count(name))) continue;
+    const ReachableScene r = generate_reachable(kind, ReachableSweepOptions{}.seed,
+                                                std::stoi(name.substr(name.rfind('-') + 1)), false, kDir);
+    const Scene scene = parsed(r);
+    auto sys = make_system(scene);
+    Problem problem(scene, scene.time, *sys);
+    const std::vector<PlacedKeyframe> placed = placed_keyframes(problem, scene);
+    const double tol = cloth_tolerance(scene);
+    VecX r0(residual_count(placed)), r1(r0.size());
+    problem.evaluate(variant_controls(scene, problem, r.variant), nullptr);
+    keyframe_residuals(problem.rollout(), placed, false, r0);
+    for (const double eps : {1e-3, 1e-4}) {
+      double worst = 0;
+      for (int how = 0; how < 4; ++how) {
+        ReachableVariant v = r.variant;
+        v.dg = turned(v.dg, eps, how), v.dv = turned(v.dv, eps, how), v.omega = turned(v.omega, eps, how);
+        problem.evaluate(variant_controls(scene, problem, v), nullptr);
+        keyframe_residuals(problem.rollout(), placed, false, r1);
+        long row = 0;
+        for (const PlacedKeyframe& k : placed) {
+          const double moved = (r1 - r0).segment(row, k.rows()).norm() / std::sqrt(k.rows() / 3.0);
+          worst = std::max(worst, moved / tol);
+          row += k.rows();
+        }
+      }
+      csv << name << ',' << kind << ',' << r.keyframes << ',' << eps << ',' << worst << '\n' << std::flush;
+      std::cout << name << " eps " << eps << ": worst keyframe moved " << worst << " tolerances" << std::endl;
+    }
   }
 }
 
