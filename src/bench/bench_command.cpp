@@ -162,6 +162,9 @@ void add_reachable_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o
   r->add_option("--reachable-dir", o->reachable.scene_dir, "where the scene files are written")->capture_default_str();
   r->add_option("--reachable-runs", o->reachable.runs_dir, "where each scene's run directory goes")->capture_default_str();
   r->add_flag("--reachable-generate-only", o->reachable.generate_only, "write the scene files and stop");
+  r->add_flag("--reachable-well-conditioned", o->reachable.well_conditioned,
+              "draw again (up to 24 times) a sheet whose keyframes a thousandth of its variant's change moves by more "
+              "than a tolerance (a knife edge); writes redraws.csv; give it its own --reachable-dir");
   r->add_option("--reachable-plot", o->reachable.plot_classes,
                 "plot a class table's pass rates (scripts/reachable_classes.py's CSV) as a PNG beside it and stop");
   r->add_flag("--reachable-stop-when-reached", o->reachable.stop_when_reached,

@@ -152,12 +152,17 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
   ensure_directory(out / "reports");
   int passed = 0, rows = 0;
   std::vector<double> all_seconds, all_cpu;
+  CsvTable redraws({"scene", "class", "redraws", "conditioning"});
   for (const auto& [name, kind] : reachable_suite(o)) {
     if (!wanted(o, name)) continue;
     const int index = std::stoi(name.substr(name.rfind('-') + 1));
     const std::filesystem::path file = o.scene_dir / (name + ".json");
-    const ReachableScene r = generate_reachable(kind, o.seed, index, false, o.scene_dir);
+    const ReachableScene r = generate_reachable(kind, o.seed, index, false, o.scene_dir, o.well_conditioned);
     write_file_atomic(file, r.scene.dump(1) + "\n");
+    if (o.well_conditioned) {
+      redraws.add({name, kind, std::to_string(r.redraws), r.conditioning < 0 ? "" : fmt(r.conditioning)});
+      redraws.write(out / "redraws.csv");
+    }
     if (o.generate_only) continue;
     const SceneRun run = run_scene(o, name, file, out);
     const nlohmann::json& report = run.report;

@@ -33,6 +33,10 @@ struct ReachableScene {
   ReachableVariant variant;
   int keyframes = 0;
   bool friction = false, thrown = false, character = false;
+  // Drawn well conditioned only: how far a thousandth of the variant's change moves its keyframes (the largest
+  // of perturbed_variant's four, in tolerances), and the draws it replaced as knife edges.
+  double conditioning = -1;
+  int redraws = 0;
 };
 
 // The classes, in the order the suite draws them.
@@ -41,8 +45,15 @@ const std::vector<std::string>& reachable_classes();
 // Scene `index` of class `kind` for `seed` (the same arguments give the same scene). `reduced`: a small
 // version (an 8 x 8 sheet or 16 agents, at most 20 frames) for tests. `directory` is where the scene file
 // will live (relative asset paths are written from it). Throws std::invalid_argument for an unknown class.
+// `well_conditioned`: a sheet whose keyframes a thousandth of the variant's change moves by more than a tolerance
+// (a knife edge: reachable from the variant's exact change alone) is drawn again, up to 24 times; flocks as
+// drawn. A scene that needs no redraw is the same scene either way.
 ReachableScene generate_reachable(const std::string& kind, unsigned seed, int index, bool reduced,
-                                  const std::filesystem::path& directory);
+                                  const std::filesystem::path& directory, bool well_conditioned = false);
+
+// The variant with its change (dg, dv, omega, force) moved by eps of itself: scaled by 1 + eps (how 0) or 1 - eps
+// (1), or turned eps off its direction one way (2) or the other (3).
+ReachableVariant perturbed_variant(const ReachableVariant& v, double eps, int how);
 
 // The variant's positions (3p) at every frame 0..frames of `base` (whose keyframes are ignored).
 std::vector<VecX> simulate_variant(const Scene& base, const ReachableVariant& variant);
@@ -61,6 +72,7 @@ struct ReachableSweepOptions {
   std::filesystem::path scene_dir = "tests/results/reachable/scenes";  // where the scene files are written
   std::filesystem::path runs_dir = "out/reachable";  // each scene's run directory
   bool generate_only = false;        // write the scene files and stop
+  bool well_conditioned = false;     // draw knife edges again (generate_reachable); redraws.csv says which
   // A class table (scripts/reachable_classes.py merges the CSVs of a run split over processes): plot its pass
   // rates as a PNG beside it and stop.
   std::filesystem::path plot_classes;

@@ -141,22 +141,32 @@ TEST(ReachableScenes, CommittedSuiteCoversItsShares) {
   }
 }
 
-// Not a check: how well conditioned each generated cloth scene's keyframes are. The variant's change (dg, or dv
-// and omega) is moved by a fraction eps of its own size (scaled by 1 +- eps, and turned eps off its direction two
-// ways), and the keyframed particles' RMS displacement from the variant's own motion is measured in each
+// --reachable-well-conditioned: a drop whose keyframe a thousandth of its tilt moves 4.8 tolerances
+// (drop-collider-8, conditioning/conditioning.csv) is drawn again until one is not; a hanging sheet that moves
+// 0.01 tolerances is the very scene the suite holds.
+TEST(ReachableScenes, AWellConditionedDrawReplacesAKnifeEdgeAndKeepsTheRest) {
+  const unsigned seed = ReachableSweepOptions{}.seed;
+  const ReachableScene hang = generate_reachable("hang-corners", seed, 0, false, kDir, true);
+  EXPECT_EQ(hang.redraws, 0);
+  EXPECT_GT(hang.conditioning, 0);
+  EXPECT_LT(hang.conditioning, 0.1);
+  EXPECT_EQ(hang.scene, generate_reachable("hang-corners", seed, 0, false, kDir).scene);
+  const ReachableScene drop = generate_reachable("drop-collider", seed, 8, false, kDir, true);
+  EXPECT_GE(drop.redraws, 1);
+  EXPECT_GE(drop.conditioning, 0);
+  EXPECT_LE(drop.conditioning, 1);
+  EXPECT_NE(drop.scene, generate_reachable("drop-collider", seed, 8, false, kDir).scene);
+  EXPECT_EQ(drop.name, "drop-collider-8");
+}
+
+// Not a check: how well conditioned each generated cloth scene's keyframes are, through the optimiser's own
+// problem. The variant's change (dg, or dv and omega) is moved by a fraction eps of its own size
+// (perturbed_variant: scaled by 1 +- eps, and turned eps off its direction two ways), and the keyframed particles' RMS displacement from the variant's own motion is measured in each
 // keyframe's tolerance; the row keeps the largest over the four. A keyframe that a thousandth of the change
 // moves by more than its tolerance is a knife edge: reachable, but from no neighbourhood a search can land in.
 //   KEYFRAME_NO_FP_TRAPS=1 KEYFRAME_CONDITIONING_CSV=OUT.csv keyframe_tests
 //     --gtest_also_run_disabled_tests --gtest_filter='ReachableScenes.DISABLED_Conditioning*'
 //   (KEYFRAME_CONDITIONING_SCENES="throw-2 ..." for some)
-Vec3 turned(const Vec3& c, double eps, int how) {
-  if (c.norm() == 0) return c;
-  if (how < 2) return c * (how == 0 ? 1 + eps : 1 - eps);
-  const Vec3 a = std::abs(c.x()) < 0.6 * c.norm() ? Vec3::UnitX() : Vec3::UnitY();
-  const Vec3 e1 = c.cross(a).normalized(), e2 = c.cross(e1).normalized();
-  return c + eps * c.norm() * (how == 2 ? e1 : e2);
-}
-
 TEST(ReachableScenes, DISABLED_ConditioningOfEveryClothScene) {
   const char* only = std::getenv("KEYFRAME_CONDITIONING_SCENES");
   const char* path = std::getenv("KEYFRAME_CONDITIONING_CSV");
@@ -182,8 +192,7 @@ TEST(ReachableScenes, DISABLED_ConditioningOfEveryClothScene) {
     for (const double eps : {1e-3, 1e-4}) {
       double worst = 0;
       for (int how = 0; how < 4; ++how) {
-        ReachableVariant v = r.variant;
-        v.dg = turned(v.dg, eps, how), v.dv = turned(v.dv, eps, how), v.omega = turned(v.omega, eps, how);
+        const ReachableVariant v = perturbed_variant(r.variant, eps, how);
         problem.evaluate(variant_controls(scene, problem, v), nullptr);
         keyframe_residuals(problem.rollout(), placed, false, r1);
         long row = 0;
