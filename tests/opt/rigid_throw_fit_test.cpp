@@ -125,12 +125,14 @@ TEST(RigidThrowFit, ReducedGeneratedThrowsAreMetFromTheScenesOwnThrow) {
 }
 
 // Not a check: what the throw search and the fit find on the full generated throws, against the variant's
-// own (Δv, ω). KEYFRAME_THROWS="0 2 4" picks the scenes.
+// own (Δv, ω). KEYFRAME_THROWS="0 2 4" picks the scenes; KEYFRAME_WELL_CONDITIONED=1 draws them as
+// --reachable-well-conditioned does.
 TEST(RigidThrowFit, DISABLED_DiagnoseGeneratedThrows) {
   const char* env = std::getenv("KEYFRAME_THROWS");
   std::istringstream list(env ? env : "0 2 3 4 5 7 9 14 17 18 19 20 21");
   for (int index; list >> index;) {
-    const ReachableScene r = generate_reachable("throw", 52, index, std::getenv("KEYFRAME_REDUCED") != nullptr, ".");
+    const ReachableScene r = generate_reachable("throw", 52, index, std::getenv("KEYFRAME_REDUCED") != nullptr, ".",
+                                                std::getenv("KEYFRAME_WELL_CONDITIONED") != nullptr);
     const Scene scene = rigid_scene(r);
     auto sys = make_system(scene);
     Problem problem(scene, scene.time, *sys);
