@@ -134,6 +134,19 @@ void finish_summary(nlohmann::json& summary, int passed, int rows, const std::ve
             << std::endl;
 }
 
+// A row of reachable.csv: the scene's own columns (name to particles), then what its run measured.
+std::vector<std::string> scene_columns(const std::string& name, const ReachableScene& r,
+                                       const std::vector<std::string>& measured) {
+  const nlohmann::json& s = r.scene;
+  std::vector<std::string> row = {
+      name, r.kind, std::to_string(r.keyframes), r.friction ? "yes" : "no", r.thrown ? "yes" : "no",
+      r.character ? "yes" : "no", s.at("controls").at("kind").get<std::string>(),
+      std::to_string(s.contains("flock") ? s["flock"]["agents"].get<int>()
+                                         : s["cloth"]["nx"].get<int>() * s["cloth"]["ny"].get<int>())};
+  row.insert(row.end(), measured.begin(), measured.end());
+  return row;
+}
+
 }  // namespace
 
 nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesystem::path& out) {
@@ -171,9 +184,8 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
     if (report.is_null()) {  // cut before its first evaluation: a failure with nothing measured
       ++rows;
       count_scene(tally[kind], false, 0, run, all_seconds, all_cpu);
-      t.add({name, kind, std::to_string(r.keyframes), r.friction ? "yes" : "no", r.thrown ? "yes" : "no",
-             r.character ? "yes" : "no", r.scene.at("controls").at("kind").get<std::string>(), "", "", "", "", "0",
-             fmt(seconds), fmt(run.cpu_seconds), run.load, "cut before its first evaluation", "no"});
+      t.add(scene_columns(name, r, {"", "", "", "0", fmt(seconds), fmt(run.cpu_seconds), run.load,
+                                    "cut before its first evaluation", "no"}));
       t.write(out / "reachable.csv");
       continue;
     }
@@ -184,13 +196,11 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
     passed += pass;
     ++rows;
     count_scene(tally[kind], pass, evaluations, run, all_seconds, all_cpu);
-    t.add({name, kind, std::to_string(r.keyframes), r.friction ? "yes" : "no", r.thrown ? "yes" : "no",
-           r.character ? "yes" : "no", r.scene.at("controls").at("kind").get<std::string>(),
-           std::to_string(r.scene.contains("flock") ? r.scene["flock"]["agents"].get<int>()
-                                                    : r.scene["cloth"]["nx"].get<int>() * r.scene["cloth"]["ny"].get<int>()),
-           worst->at("name").get<std::string>(), fmt(worst->at("miss_before").get<double>()),
-           fmt(worst->at("miss_after").get<double>()), std::to_string(evaluations), fmt(seconds),
-           fmt(run.cpu_seconds), run.load, cut ? "cut" : report.at("diagnosis").at("outcome").get<std::string>(), pass ? "yes" : "no"});
+    t.add(scene_columns(name, r,
+                        {worst->at("name").get<std::string>(), fmt(worst->at("miss_before").get<double>()),
+                         fmt(worst->at("miss_after").get<double>()), std::to_string(evaluations), fmt(seconds),
+                         fmt(run.cpu_seconds), run.load,
+                         cut ? "cut" : report.at("diagnosis").at("outcome").get<std::string>(), pass ? "yes" : "no"}));
     t.write(out / "reachable.csv");  // after every scene: a cut-off run keeps what it measured
     summary["diagnoses"][name] = run.outcome.diagnosis;
   }
