@@ -249,6 +249,8 @@ void add_bench_command(CLI::App& app) {
       return o->only.empty() || std::find(o->only.begin(), o->only.end(), s) != o->only.end();
     };
     const std::filesystem::path out = o->out;
+    const bool reachable = std::find(o->only.begin(), o->only.end(), "reachable") != o->only.end();
+    if (reachable) check_reachable_options(o->reachable);  // before anything is written
     ensure_directory(out);
     nlohmann::json summary = {{"quick", o->quick}};
     if (want("memory")) summary["memory"] = bench_memory(o->memory, out, std::filesystem::read_symlink("/proc/self/exe"));
@@ -263,8 +265,7 @@ void add_bench_command(CLI::App& app) {
     // The suite takes up to an hour: only when named.
     if (std::find(o->only.begin(), o->only.end(), "robustness") != o->only.end())
       summary["robustness"] = bench_robustness(o->robustness, out);
-    if (std::find(o->only.begin(), o->only.end(), "reachable") != o->only.end())
-      summary["reachable"] = bench_reachable(o->reachable, out);
+    if (reachable) summary["reachable"] = bench_reachable(o->reachable, out);
     write_file_atomic(out / "summary.json", summary.dump(2) + "\n");
   });
 }

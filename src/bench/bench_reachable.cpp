@@ -149,6 +149,21 @@ std::vector<std::string> scene_columns(const std::string& name, const ReachableS
 
 }  // namespace
 
+// A scene drawn well conditioned: its redraws and measure into redraws.csv (written after each).
+void add_redraws(CsvTable& redraws, const ReachableScene& r, const std::filesystem::path& out) {
+  redraws.add({r.name, r.kind, std::to_string(r.redraws), r.conditioning < 0 ? "" : fmt(r.conditioning)});
+  redraws.write(out / "redraws.csv");
+}
+
+void check_reachable_options(const ReachableSweepOptions& o) {
+  const auto suite = reachable_suite(o);  // its classes and count; the names are not a filter there
+  for (const std::string& s : o.scenes)
+    if (s != "smoke" && std::none_of(suite.begin(), suite.end(), [&](const auto& n) { return n.first == s; }))
+      throw InputError("--reachable-scenes: no scene \"" + s + "\" among the " + std::to_string(suite.size()) +
+                       " the generator draws (seed " + std::to_string(o.seed) + "; names are CLASS-INDEX, e.g. " +
+                       (suite.empty() ? std::string("throw-3") : suite.front().first) + ")");
+}
+
 nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesystem::path& out) {
   CsvTable t({"scene", "class", "keyframes", "friction", "thrown", "character", "controls", "particles", "keyframe",
               "miss_before", "miss_after", "evaluations", "seconds", "cpu_seconds", "load", "outcome", "pass"});
@@ -158,6 +173,7 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
                  false);
     return {{"plot", png.string()}};
   }
+  check_reachable_options(o);
   nlohmann::json summary = {{"seed", o.seed}, {"load_before", load_average()}};
   std::map<std::string, ClassTally> tally;
   ensure_directory(o.scene_dir);
@@ -172,10 +188,7 @@ nlohmann::json bench_reachable(const ReachableSweepOptions& o, const std::filesy
     const std::filesystem::path file = o.scene_dir / (name + ".json");
     const ReachableScene r = generate_reachable(kind, o.seed, index, false, o.scene_dir, o.well_conditioned);
     write_file_atomic(file, r.scene.dump(1) + "\n");
-    if (o.well_conditioned) {
-      redraws.add({name, kind, std::to_string(r.redraws), r.conditioning < 0 ? "" : fmt(r.conditioning)});
-      redraws.write(out / "redraws.csv");
-    }
+    if (o.well_conditioned) add_redraws(redraws, r, out);
     if (o.generate_only) continue;
     const SceneRun run = run_scene(o, name, file, out);
     const nlohmann::json& report = run.report;

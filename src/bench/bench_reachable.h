@@ -86,6 +86,10 @@ struct ReachableSweepOptions {
 // The suite's scene list for the options (name, class), in order.
 std::vector<std::pair<std::string, std::string>> reachable_suite(const ReachableSweepOptions& o);
 
+// Throws InputError when a name --reachable-scenes gives is not one of the suite's (or "smoke"): a typo would
+// otherwise run nothing and exit 0. bench_reachable checks it first too.
+void check_reachable_options(const ReachableSweepOptions& o);
+
 // Generates the suite, writes each scene file, optimises each with `keyframe optimize`'s job at its
 // defaults (cut at pass_seconds CPU seconds: outcome "cut") and writes reachable.csv (a row a scene, written after each), reachable_classes.csv (pass
 // rate, median evaluations, median and worst seconds a class), reachable.png and load.txt.

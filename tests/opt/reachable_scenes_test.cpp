@@ -10,9 +10,11 @@
 #include <set>
 #include <sstream>
 
+#include "../sim/character_test_util.h"
 #include "../support/reachable_classes.h"
 #include "bench/bench_reachable.h"
 #include "adjoint/rollout.h"
+#include "core/error.h"
 #include "opt/keyframe_residuals.h"
 #include "opt/keyframes/keyframe_common.h"
 #include "opt/problem.h"
@@ -139,6 +141,24 @@ TEST(ReachableScenes, CommittedSuiteCoversItsShares) {
                                                 std::stoi(name.substr(name.rfind('-') + 1)), false, kDir);
     EXPECT_EQ(r.scene, nlohmann::json::parse(in)) << name;
   }
+}
+
+// A scene name the suite does not hold is refused with one line before anything is written (a typo ran nothing
+// and exited 0).
+TEST(ReachableScenes, AnUnknownSceneNameIsRefusedBeforeAnythingIsWritten) {
+  test::TempDir dir;
+  ReachableSweepOptions o;
+  o.scenes = {"throw-1", "throw-99"};
+  o.scene_dir = dir.path() / "scenes";
+  o.generate_only = true;
+  try {
+    bench_reachable(o, dir.path() / "out");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("\"throw-99\""), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(o.scene_dir));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out"));
 }
 
 // --reachable-well-conditioned: a drop whose keyframe a thousandth of its tilt moves 4.8 tolerances
