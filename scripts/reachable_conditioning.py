@@ -9,12 +9,13 @@ Result files merge as in scripts/reachable_classes.py (a scene counts once, as t
 Usage: scripts/reachable_conditioning.py OUT.csv CONDITIONING.csv IN.csv ..."""
 import csv, os, shutil, subprocess, sys, tempfile
 
+sys.dont_write_bytecode = True  # no __pycache__ beside the scripts
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from reachable_classes import merged_rows
+
 if len(sys.argv) < 4:
     raise SystemExit(__doc__)
-result = {}
-for f in sys.argv[3:]:
-    for r in csv.DictReader(open(f)):
-        result[r["scene"]] = r
+result = merged_rows(sys.argv[3:])
 moved = {}
 for r in csv.DictReader(open(sys.argv[2])):
     moved.setdefault(r["scene"], {"class": r["class"]})[r["eps"]] = float(r["worst_displacement_tol"])

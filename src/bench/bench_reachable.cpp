@@ -147,13 +147,13 @@ std::vector<std::string> scene_columns(const std::string& name, const ReachableS
   return row;
 }
 
-}  // namespace
-
 // A scene drawn well conditioned: its redraws and measure into redraws.csv (written after each).
 void add_redraws(CsvTable& redraws, const ReachableScene& r, const std::filesystem::path& out) {
   redraws.add({r.name, r.kind, std::to_string(r.redraws), r.conditioning < 0 ? "" : fmt(r.conditioning)});
   redraws.write(out / "redraws.csv");
 }
+
+}  // namespace
 
 void check_reachable_options(const ReachableSweepOptions& o) {
   const auto suite = reachable_suite(o);  // its classes and count; the names are not a filter there
