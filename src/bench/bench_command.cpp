@@ -153,7 +153,8 @@ void add_adjoint_sweep_options(CLI::App* sub, const std::shared_ptr<BenchOptions
 void add_reachable_options(CLI::App* sub, const std::shared_ptr<BenchOptions>& o) {
   auto* r = sub->add_option_group("reachable suite");
   r->add_option("--reachable-seed", o->reachable.seed, "the generator's seed")->capture_default_str();
-  r->add_option("--reachable-count", o->reachable.count, "scenes, shared over the classes")
+  r->add_option("--reachable-count", o->reachable.count,
+                "scenes, shared over the classes (a class outside the suite, poncho, when named: that many)")
       ->capture_default_str()->check(CLI::Range(1, 100000));
   r->add_option("--reachable-classes", o->reachable.classes, "only these classes")
       ->delimiter(',')->check(CLI::IsMember(reachable_classes()));

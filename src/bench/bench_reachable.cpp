@@ -140,9 +140,7 @@ std::vector<std::string> scene_columns(const std::string& name, const ReachableS
   const nlohmann::json& s = r.scene;
   std::vector<std::string> row = {
       name, r.kind, std::to_string(r.keyframes), r.friction ? "yes" : "no", r.thrown ? "yes" : "no",
-      r.character ? "yes" : "no", s.at("controls").at("kind").get<std::string>(),
-      std::to_string(s.contains("flock") ? s["flock"]["agents"].get<int>()
-                                         : s["cloth"]["nx"].get<int>() * s["cloth"]["ny"].get<int>())};
+      r.character ? "yes" : "no", s.at("controls").at("kind").get<std::string>(), std::to_string(r.particles)};
   row.insert(row.end(), measured.begin(), measured.end());
   return row;
 }

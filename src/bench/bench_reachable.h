@@ -32,6 +32,7 @@ struct ReachableScene {
   nlohmann::json scene;  // the scene file, keyframes included
   ReachableVariant variant;
   int keyframes = 0;
+  int particles = 0;     // the sheet's particles or the flock's agents
   bool friction = false, thrown = false, character = false;
   // Drawn well conditioned only: how far a thousandth of the variant's change moves its keyframes (the largest
   // of perturbed_variant's four, in tolerances), and the draws it replaced as knife edges.
@@ -39,8 +40,12 @@ struct ReachableScene {
   int redraws = 0;
 };
 
-// The classes, in the order the suite draws them.
+// The classes, in the order the suite draws them; the last, "poncho", is outside the 100-scene suite and
+// drawn only when named (--reachable-classes poncho).
 const std::vector<std::string>& reachable_classes();
+
+// The class puts its sheet on a character (the capes and the poncho).
+bool reachable_class_on_character(const std::string& kind);
 
 // Scene `index` of class `kind` for `seed` (the same arguments give the same scene). `reduced`: a small
 // version (an 8 x 8 sheet or 16 agents, at most 20 frames) for tests. `directory` is where the scene file

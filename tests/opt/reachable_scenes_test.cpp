@@ -161,6 +161,33 @@ TEST(ReachableScenes, AnUnknownSceneNameIsRefusedBeforeAnythingIsWritten) {
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "out"));
 }
 
+// The poncho class stays out of the 100 (which it would otherwise reshuffle) and, named, gives `count` scenes;
+// its keyframes name free vertices of the mesh (a side, a vertex, a few, or all), not grid indices.
+TEST(ReachableCapeScenes, APonchoIsDrawnOnlyWhenNamedAndKeysFreeVerticesOfItsMesh) {
+  for (const auto& [name, kind] : reachable_suite(ReachableSweepOptions{})) EXPECT_NE(kind, "poncho") << name;
+  ReachableSweepOptions o;
+  o.classes = {"poncho", "cape"};
+  o.count = 8;
+  int ponchos = 0;
+  for (const auto& [name, kind] : reachable_suite(o)) ponchos += kind == "poncho";
+  EXPECT_EQ(ponchos, 8);
+  std::set<std::size_t> sizes;
+  for (int index = 0; index < 8; ++index) {
+    const ReachableScene r = generate_reachable("poncho", 52, index, true, kDir);
+    const Scene scene = parsed(r);
+    ASSERT_TRUE(scene.cloth && scene.cloth->mesh);
+    EXPECT_EQ(r.particles, scene.cloth->mesh->particles());
+    for (const ObjectiveSpec& k : scene.objectives) {
+      sizes.insert(k.particles.size());
+      for (int i : k.particles) {
+        EXPECT_LT(i, r.particles);
+        EXPECT_FALSE(std::binary_search(scene.cloth->pins.begin(), scene.cloth->pins.end(), i)) << r.name << " " << i;
+      }
+    }
+  }
+  EXPECT_GE(sizes.size(), 3u) << "the draws name particle sets of one or two sizes only";
+}
+
 // --reachable-well-conditioned: a drop whose keyframe a thousandth of its tilt moves 4.8 tolerances
 // (drop-collider-8, conditioning/conditioning.csv) is drawn again until one is not; a hanging sheet that moves
 // 0.01 tolerances is the very scene the suite holds.

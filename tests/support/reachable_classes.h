@@ -13,7 +13,7 @@ namespace kf::test {
 inline std::vector<std::string> reachable_classes_with_character(bool character) {
   std::vector<std::string> v;
   for (const std::string& c : reachable_classes())
-    if ((c.rfind("cape", 0) == 0) == character) v.push_back(c);
+    if (reachable_class_on_character(c) == character) v.push_back(c);
   return v;
 }
 
