@@ -143,9 +143,10 @@ nlohmann::json cloth_block(const std::string& kind, Draw& d, int index, bool red
   return c;
 }
 
-// A cape on one of the two characters (the robustness suite's settings), its sheet size drawn.
-void cape_scene(const std::string& kind, Draw& d, bool reduced, const std::filesystem::path& directory,
-                nlohmann::json& s) {
+// A sheet on a character: a cape on one of the two (the robustness suite's settings, its size drawn), or the
+// poncho.
+void sheet_on_character(const std::string& kind, Draw& d, bool reduced, const std::filesystem::path& directory,
+                        nlohmann::json& s) {
   const std::filesystem::path repo = KEYFRAME_REPOSITORY;
   const auto relative = [&](const char* asset) { return std::filesystem::proximate(repo / asset, directory).string(); };
   if (kind == "poncho") {  // scenes/robustness/poncho.json's sheet and pins, its mass drawn
@@ -215,7 +216,7 @@ std::vector<int> keyframe_particles(Draw& d, const ClothSpec& cl, const VecX& re
   std::vector<int> p;
   switch (what) {
     case 0: break;  // all
-    case 1: {       // an edge away from the pins when there are any
+    case 1: {       // an edge away from the pins when there are any; a mesh's side (its pins left out below)
       if (cl.mesh) {
         p = mesh_side(d, rest);
         break;
@@ -333,7 +334,7 @@ void draw_scene(const std::string& kind, Draw& d, int index, bool reduced, const
     r.variant.force = d.uniform(0.2, 0.6) * Vec3(std::cos(b), 0, std::sin(b));
   } else if (reachable_class_on_character(kind)) {
     r.character = true;
-    cape_scene(kind, d, reduced, directory, s);
+    sheet_on_character(kind, d, reduced, directory, s);
     s["controls"] = {{"kind", "per_frame"}};
     r.variant.dg = d.uniform(1.0, 3.0) * d.direction();
   } else {
@@ -440,7 +441,7 @@ Drawn draw_reachable(const std::string& kind, std::uint64_t h, int index, bool r
     Draw pick(h + 17);
     for (int f : out.when) {
       if (base.flock) flock_keyframe(kind, f, base.particles(), out.moved[f], still[f], t);
-      else cloth_keyframe(pick, base, f, still[0], out.moved[f], still[f], t);
+      else cloth_keyframe(pick, base, f, out.rest, out.moved[f], still[f], t);
     }
     r.scene["objectives"] = t.objectives;
     if (t.worst >= 3 || attempt == 3) break;
